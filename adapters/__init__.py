@@ -1,0 +1,1 @@
+"""Engine adapters: each turns a Scene into a Trajectory."""

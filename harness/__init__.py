@@ -1,0 +1,1 @@
+"""Runner, metrics, sweeps, results store, report and command-line interface."""

@@ -1,0 +1,9 @@
+"""Scene sub-commands: ``list``, ``show``, ``validate`` and ``demo`` (filled in by the foundation work)."""
+
+from __future__ import annotations
+
+
+def register(subparsers) -> None:
+    """Add the scene sub-commands to ``subparsers``."""
+    demo = subparsers.add_parser("demo", help="the main job of the README")
+    demo.set_defaults(handler=lambda args: 0)

@@ -1,0 +1,1 @@
+"""Nonsmooth Moreau--Jean reference solver (no scene, engine or report imports)."""

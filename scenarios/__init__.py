@@ -1,0 +1,1 @@
+"""Engine-neutral scene description, shared geometry, scene library and analytic references."""
