@@ -1,4 +1,4 @@
-"""Scene sub-commands: ``list``, ``show``, ``validate`` and ``demo`` (filled in by the foundation work)."""
+"""Scene sub-commands: ``list``, ``show``, ``validate`` and ``demo``."""
 
 from __future__ import annotations
 
