@@ -1,0 +1,256 @@
+"""Lossless conversion of scenes to and from plain dicts, JSON and TOML, and unit rescaling.
+
+The dict form is what user scene files contain: a table per scene with lists of tables for the
+elements; polymorphic elements (shapes, joints, loads, outputs) carry a ``kind`` key. ``None``
+values are omitted (TOML has no null). Reading checks every key: an unknown key or a missing
+required one is an error naming its path (``bodies[0].shapes[1].radius``), and every value goes
+through the same validation as Python-built scenes.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import tomllib
+from enum import Enum
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+import tomli_w
+
+from .bodies import Body
+from .contacts import ContactPair
+from .drivers import Driver
+from .expectations import Expectation
+from .joints import JOINT_TYPES, ClearanceRevoluteJoint
+from .loads import LOAD_TYPES
+from .outputs import OUTPUT_TYPES
+from .scene import Scene
+from .shapes import SHAPE_TYPES
+from .units import UnitSystem
+from .validation import SceneError
+
+#: Element collections of a scene: key -> (kind table or single class).
+COLLECTIONS: dict[str, Any] = {
+    "bodies": Body,
+    "joints": JOINT_TYPES,
+    "clearance_joints": ClearanceRevoluteJoint,
+    "contacts": ContactPair,
+    "loads": LOAD_TYPES,
+    "drivers": Driver,
+    "outputs": OUTPUT_TYPES,
+    "expectations": Expectation,
+}
+
+
+# ---------------------------------------------------------------------------- to dict
+def _plain(value: Any) -> Any:
+    if dataclasses.is_dataclass(value):
+        return element_to_dict(value)
+    if isinstance(value, Enum):
+        return value.value
+    if isinstance(value, MappingProxyType | dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, tuple | list):
+        return [_plain(v) for v in value]
+    return value
+
+
+def element_to_dict(element: Any) -> dict[str, Any]:
+    """Plain-dict form of a scene element (``kind`` first for polymorphic elements)."""
+    out: dict[str, Any] = {}
+    kind = getattr(type(element), "kind", None)
+    if isinstance(kind, str) and kind and not isinstance(element, Expectation):
+        out["kind"] = kind
+    for f in dataclasses.fields(element):
+        value = getattr(element, f.name)
+        if value is None:
+            continue
+        out[f.name] = _plain(value)
+    return out
+
+
+def scene_to_dict(scene: Scene) -> dict[str, Any]:
+    """Plain-dict form of ``scene`` (JSON and TOML serialisable, lossless)."""
+    out = element_to_dict(scene)
+    out["units"] = dataclasses.asdict(scene.units)
+    for key in list(out):
+        if out[key] == [] and key in COLLECTIONS:
+            del out[key]
+    return out
+
+
+def scene_to_json(scene: Scene, indent: int | None = 2) -> str:
+    return json.dumps(scene_to_dict(scene), indent=indent)
+
+
+def scene_to_toml(scene: Scene) -> str:
+    return tomli_w.dumps(scene_to_dict(scene))
+
+
+# ---------------------------------------------------------------------------- from dict
+def _build(cls: type, data: Any, path: str, **extra: Any) -> Any:
+    if not isinstance(data, dict):
+        raise SceneError(path, data, "must be a table (mapping)")
+    fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
+    # ``kind`` selects the class of polymorphic elements; it is a field only of expectations.
+    ignored = set() if "kind" in fields else {"kind"}
+    unknown = sorted(set(data) - set(fields) - ignored)
+    if unknown:
+        raise SceneError(f"{path}.{unknown[0]}", data[unknown[0]],
+                         f"unknown field for {cls.__name__} (fields: {', '.join(fields)})")
+    required = [
+        name for name, f in fields.items()
+        if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
+    ]
+    for name in required:
+        if name not in data and name not in extra:
+            raise SceneError(f"{path}.{name}", None, f"missing required field of {cls.__name__}")
+    kwargs = {k: v for k, v in data.items() if k not in ignored}
+    kwargs.update(extra)
+    try:
+        return cls(**kwargs)
+    except SceneError as error:
+        name = data.get("name")
+        field = error.field
+        # Element errors carry "collection['name'].field"; use the document path instead.
+        marker = f"[{name!r}]"
+        if isinstance(name, str) and marker in field:
+            field = field.split(marker, 1)[1].lstrip(".")
+        prefix = f"{path} ({name!r})" if isinstance(name, str) else path
+        raise SceneError(f"{prefix}.{field}" if field else prefix, error.value,
+                         error.reason) from None
+    except TypeError as error:
+        raise SceneError(path, data, f"cannot build {cls.__name__}: {error}") from None
+
+
+def _polymorphic(table: dict[str, type], data: Any, path: str) -> Any:
+    if not isinstance(data, dict):
+        raise SceneError(path, data, "must be a table (mapping)")
+    kind = data.get("kind")
+    if kind not in table:
+        raise SceneError(f"{path}.kind", kind, f"must be one of {sorted(table)}")
+    return _build(table[kind], data, path)
+
+
+def _list(data: Any, path: str) -> list:
+    if not isinstance(data, list):
+        raise SceneError(path, data, "must be a list (array of tables)")
+    return data
+
+
+def body_from_dict(data: Any, path: str) -> Body:
+    if isinstance(data, dict) and "shapes" in data:
+        shapes = tuple(
+            _polymorphic(SHAPE_TYPES, s, f"{path}.shapes[{i}]")
+            for i, s in enumerate(_list(data["shapes"], f"{path}.shapes"))
+        )
+        data = {k: v for k, v in data.items() if k != "shapes"}
+        return _build(Body, data, path, shapes=shapes)
+    return _build(Body, data, path)
+
+
+def scene_from_dict(data: Any) -> Scene:
+    """Build and validate a :class:`Scene` from its plain-dict form."""
+    if not isinstance(data, dict):
+        raise SceneError("scene", data, "must be a table (mapping)")
+    data = dict(data)
+    units_data = data.pop("units", {})
+    if not isinstance(units_data, dict):
+        raise SceneError("units", units_data, "must be a table with length, mass, time")
+    unknown = sorted(set(units_data) - {"length", "mass", "time"})
+    if unknown:
+        raise SceneError(f"units.{unknown[0]}", units_data[unknown[0]], "unknown unit field")
+    units = UnitSystem(**units_data)
+    collections: dict[str, tuple] = {}
+    for key, kind in COLLECTIONS.items():
+        items = _list(data.pop(key, []), key)
+        built = []
+        for index, item in enumerate(items):
+            path = f"{key}[{index}]"
+            if key == "bodies":
+                built.append(body_from_dict(item, path))
+            elif isinstance(kind, dict):
+                built.append(_polymorphic(kind, item, path))
+            else:
+                built.append(_build(kind, item, path))
+        collections[key] = tuple(built)
+    if "tags" in data:
+        data["tags"] = tuple(_list(data["tags"], "tags"))
+    return _build(Scene, data, "scene", units=units, **collections)
+
+
+def scene_from_json(text: str) -> Scene:
+    return scene_from_dict(json.loads(text))
+
+
+def scene_from_toml(text: str) -> Scene:
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise SceneError("toml", None, f"not valid TOML: {error}") from None
+    # A scene file may hold the scene at top level or under a [scene] table.
+    if set(data) == {"scene"}:
+        data = data["scene"]
+    return scene_from_dict(data)
+
+
+def load_scene_file(path: str | Path) -> Scene:
+    """Read a scene from a ``.toml`` or ``.json`` file."""
+    path = Path(path)
+    text = path.read_text()
+    if path.suffix == ".json":
+        return scene_from_json(text)
+    return scene_from_toml(text)
+
+
+# ---------------------------------------------------------------------------- rescaling
+def _scale(value: Any, factor: float) -> Any:
+    if isinstance(value, tuple):
+        return tuple(_scale(v, factor) for v in value)
+    if isinstance(value, float | int) and not isinstance(value, bool):
+        return float(value) * factor
+    return value
+
+
+def rescale_element(element: Any, source: UnitSystem, target: UnitSystem) -> Any:
+    """Copy of a scene element (or scene) with every dimensioned value converted.
+
+    Dimensions come from field metadata (``dimension``), or from the element's
+    ``field_dimension(name)`` where they depend on other fields (drivers, expectations).
+    """
+    changes: dict[str, Any] = {}
+    for f in dataclasses.fields(element):
+        value = getattr(element, f.name)
+        dynamic = getattr(element, "field_dimension", None)
+        dimension = dynamic(f.name) if dynamic else None
+        if dimension is None:
+            dimension = f.metadata.get("dimension")
+        if isinstance(dimension, dict):  # per-key dimensions of a parameter mapping
+            changes[f.name] = MappingProxyType({
+                key: v * source.factor_to(target, dimension[key]) for key, v in value.items()
+            })
+        elif dimension is not None and value is not None:
+            changes[f.name] = _scale(value, source.factor_to(target, dimension))
+        elif isinstance(value, tuple) and value and dataclasses.is_dataclass(value[0]):
+            changes[f.name] = tuple(rescale_element(v, source, target) for v in value)
+        elif isinstance(value, UnitSystem):
+            changes[f.name] = target
+    return dataclasses.replace(element, **changes)
+
+
+def is_close_scene(a: Scene, b: Scene, rtol: float = 1e-12) -> bool:
+    """True when two scenes have the same structure and numbers equal within ``rtol``."""
+
+    def close(x: Any, y: Any) -> bool:
+        if isinstance(x, dict) and isinstance(y, dict):
+            return x.keys() == y.keys() and all(close(x[k], y[k]) for k in x)
+        if isinstance(x, list) and isinstance(y, list):
+            return len(x) == len(y) and all(close(u, v) for u, v in zip(x, y, strict=True))
+        if isinstance(x, float | int) and isinstance(y, float | int):
+            return math.isclose(x, y, rel_tol=rtol, abs_tol=0.0) or x == y
+        return x == y
+
+    return close(scene_to_dict(a), scene_to_dict(b))
