@@ -18,8 +18,7 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
-import tomli_w
-
+from . import toml_format
 from .bodies import Body
 from .contacts import ContactPair
 from .drivers import Driver
@@ -87,7 +86,7 @@ def scene_to_json(scene: Scene, indent: int | None = 2) -> str:
 
 
 def scene_to_toml(scene: Scene) -> str:
-    return tomli_w.dumps(scene_to_dict(scene))
+    return toml_format.dumps(scene_to_dict(scene))
 
 
 # ---------------------------------------------------------------------------- from dict
