@@ -189,7 +189,7 @@ def scene_from_toml(text: str) -> Scene:
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
-        raise SceneError("toml", None, f"not valid TOML: {error}") from None
+        raise SceneError("file", "TOML text", f"not valid TOML: {error}") from None
     # A scene file may hold the scene at top level or under a [scene] table.
     if set(data) == {"scene"}:
         data = data["scene"]

@@ -56,8 +56,10 @@ class Shape:
     def __post_init__(self) -> None:
         check_name("name", self.name)
         object.__setattr__(self, "position", check_finite_vector("position", self.position, 3))
+        check_unit_quaternion("orientation", self.orientation)
+        # Stored as given (norm within 1e-6 of 1); engines normalise where they use it.
         object.__setattr__(
-            self, "orientation", check_unit_quaternion("orientation", self.orientation)
+            self, "orientation", check_finite_vector("orientation", self.orientation, 4)
         )
         self._check_parameters()
 

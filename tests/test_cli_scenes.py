@@ -1,0 +1,94 @@
+"""The scene sub-commands of the CLI, run in-process through ``main``."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from clearbench.harness.cli import main
+from clearbench.scenarios.registry import scene_names
+from clearbench.scenarios.serialization import load_scene_file, scene_from_toml
+
+ROOT = Path(__file__).resolve().parent.parent
+EXAMPLE = ROOT / "examples" / "ball_on_ramp.toml"
+
+
+def test_list_shows_every_scene_with_tags_and_features(capsys):
+    assert main(["list"]) == 0
+    out = capsys.readouterr().out
+    for name in scene_names():
+        assert name in out
+    assert "tags:" in out and "features:" in out
+    assert "Engines:" in out and "reference" in out
+
+
+def test_list_with_unknown_tag_fails_naming_the_tags(capsys):
+    assert main(["list", "--tag", "nope"]) == 2
+    assert "smoke" in capsys.readouterr().err
+
+
+def test_show_prints_a_scene_file_that_reads_back(capsys):
+    assert main(["show", "clearance-pendulum", "--units", "mm-g-ms"]) == 0
+    scene = scene_from_toml(capsys.readouterr().out)
+    assert scene.units.length == "mm"
+    assert scene.clearance_joints[0].radial_clearance == pytest.approx(0.1, rel=1e-12)
+
+
+def test_show_unknown_scene_exits_non_zero(capsys):
+    assert main(["show", "no-such-scene"]) == 2
+    assert "known scenes" in capsys.readouterr().err
+
+
+def test_show_bad_units_names_the_accepted_units(capsys):
+    assert main(["show", "pendulum", "--units", "ft-lb-s"]) == 2
+    assert "mm" in capsys.readouterr().err
+
+
+def test_validate_accepts_the_hand_written_example(capsys):
+    assert main(["validate", str(EXAMPLE)]) == 0
+    assert "valid scene 'ball-on-ramp'" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("replace", "by", "expected"),
+    [
+        ("mass = 4.11 ", "mass = -4.11 ", "mass = -4.11"),
+        ('body_b = "ball"', 'body_b = "balll"', "body_b = 'balll'"),
+        ("radius = 5.0", "radius = nan", "radius = nan"),
+        ("restitution = 0.6", "restitution = 1.6", "restitution = 1.6"),
+        ("friction = 0.2", "friction = -0.2", "friction = -0.2"),
+        ("time_step = 0.1 ", "time_step = 0.0 ", "time_step = 0.0"),
+        ('name = "ramp"', 'name = "ramp"\nmasse = 3.0', "masse"),
+        ("horizon = 200.0", "horizon = [", "not valid TOML"),
+    ],
+)
+def test_validate_broken_file_names_field_and_value(tmp_path, capsys, replace, by, expected):
+    text = EXAMPLE.read_text()
+    assert replace in text
+    broken = tmp_path / "broken.toml"
+    broken.write_text(text.replace(replace, by, 1))
+    assert main(["validate", str(broken)]) == 2
+    assert expected in capsys.readouterr().err
+
+
+def test_validate_missing_file(capsys):
+    assert main(["validate", "/nonexistent/scene.toml"]) == 2
+    assert "no such file" in capsys.readouterr().err
+
+
+def test_readme_scene_example_is_the_shipped_example_and_valid():
+    readme = (ROOT / "README.md").read_text()
+    blocks = re.findall(r"```toml\n(.*?)```", readme, flags=re.S)
+    assert blocks, "the README documents the scene format with a TOML example"
+    assert blocks[0] == EXAMPLE.read_text()
+    assert scene_from_toml(blocks[0]) == load_scene_file(EXAMPLE)
+
+
+def test_every_command_has_help(capsys):
+    for command in ("list", "show", "validate", "demo"):
+        with pytest.raises(SystemExit) as caught:
+            main([command, "--help"])
+        assert caught.value.code == 0
+        assert "usage" in capsys.readouterr().out
