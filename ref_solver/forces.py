@@ -1,0 +1,197 @@
+"""Applied forces: gravity and the force elements of a :class:`~.system.MultibodySystem`.
+
+Generalised force per body, shape (nb, 6): force (3,) in world axes and torque (3,) in BODY axes
+about the centre of mass. Gyroscopic terms are not included (the stepper treats them with a
+momentum-conserving update). Parameter layout of ``force_parameters`` rows (points relative to
+the centre of mass, body axes):
+
+- linear spring: [0:3] point on A, [3:6] point on B, [6] stiffness, [7] damping,
+  [8] rest length, [9] preload. Tension T = preload + k (L - L0) + c dL/dt pulls the points
+  together.
+- torsional spring: [0:3] axis in A's body axes, [3:6] reference vector in A, [6:9] the same
+  reference vector in B (equal in world at t = 0), [9] stiffness, [10] damping, [11] rest angle,
+  [12] preload. Moment on B about the axis: -(preload + k (phi - rest) + c dphi/dt), phi in
+  (-pi, pi]; the opposite on A.
+- point force: [0:3] point on the body, [3:6] force, [6] 0 world / 1 body axes, [7] start time,
+  [8] end time (active start <= t < end).
+- moment: [0:3] moment, [3] 0 world / 1 body axes, [4] start time, [5] end time.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from clearbench.scenarios.quaternion import quat_exp, quat_multiply, quat_to_matrix
+
+from .linalg3 import cross, dot, mat_t_vec, mat_vec
+from .system import (
+    FORCE_LINEAR_SPRING,
+    FORCE_MOMENT,
+    FORCE_POINT_FORCE,
+    FORCE_TORSIONAL_SPRING,
+)
+
+
+@njit(cache=True)
+def rotation_matrices(p):
+    """(nb, 3, 3) rotation matrices of the quaternions p (nb, 4)."""
+    out = np.empty((p.shape[0], 3, 3))
+    for b in range(p.shape[0]):
+        out[b] = quat_to_matrix(p[b])
+    return out
+
+
+@njit(cache=True, inline="always")
+def _add_force_at(out, body, x, rotation, point_world, force):
+    for i in range(3):
+        out[body, i] += force[i]
+    torque_world = cross(point_world - x[body], force)
+    torque_body = mat_t_vec(rotation[body], torque_world)
+    for i in range(3):
+        out[body, 3 + i] += torque_body[i]
+
+
+@njit(cache=True, inline="always")
+def _add_torque(out, body, rotation, torque_world):
+    torque_body = mat_t_vec(rotation[body], torque_world)
+    for i in range(3):
+        out[body, 3 + i] += torque_body[i]
+
+
+@njit(cache=True, inline="always")
+def _point_velocity(v, omega, rotation, body, local):
+    return v[body] + mat_vec(rotation[body], cross(omega[body], local))
+
+
+@njit(cache=True)
+def element_forces(t, x, rotation, v, omega, kinds, body_a, body_b, parameters, springs_only,
+                   out):
+    """Add the force elements' generalised forces to ``out`` (nb, 6).
+
+    With ``springs_only`` the time-switched point forces and moments are skipped (used for the
+    stiffness Jacobian).
+    """
+    for e in range(kinds.shape[0]):
+        kind = kinds[e]
+        prm = parameters[e]
+        a = body_a[e]
+        b = body_b[e]
+        if kind == FORCE_LINEAR_SPRING:
+            pa = x[a] + mat_vec(rotation[a], prm[0:3])
+            pb = x[b] + mat_vec(rotation[b], prm[3:6])
+            d = pb - pa
+            length = math.sqrt(dot(d, d))
+            if length == 0.0:
+                continue
+            e_ab = d / length
+            rate = dot(e_ab, _point_velocity(v, omega, rotation, b, prm[3:6])
+                       - _point_velocity(v, omega, rotation, a, prm[0:3]))
+            tension = prm[9] + prm[6] * (length - prm[8]) + prm[7] * rate
+            _add_force_at(out, a, x, rotation, pa, tension * e_ab)
+            _add_force_at(out, b, x, rotation, pb, -tension * e_ab)
+        elif kind == FORCE_TORSIONAL_SPRING:
+            axis = mat_vec(rotation[a], prm[0:3])
+            ref_a = mat_vec(rotation[a], prm[3:6])
+            ref_b = mat_vec(rotation[b], prm[6:9])
+            ref_b = ref_b - dot(ref_b, axis) * axis
+            angle = math.atan2(dot(axis, cross(ref_a, ref_b)), dot(ref_a, ref_b))
+            rate = dot(axis, mat_vec(rotation[b], omega[b]) - mat_vec(rotation[a], omega[a]))
+            moment = -(prm[12] + prm[9] * (angle - prm[11]) + prm[10] * rate)
+            _add_torque(out, b, rotation, moment * axis)
+            _add_torque(out, a, rotation, -moment * axis)
+        elif kind == FORCE_POINT_FORCE and not springs_only:
+            if prm[7] <= t < prm[8]:
+                force = prm[3:6].copy()
+                if prm[6] > 0.5:
+                    force = mat_vec(rotation[a], force)
+                _add_force_at(out, a, x, rotation, x[a] + mat_vec(rotation[a], prm[0:3]), force)
+        elif kind == FORCE_MOMENT and not springs_only:
+            if prm[4] <= t < prm[5]:
+                moment = prm[0:3].copy()
+                if prm[3] > 0.5:
+                    moment = mat_vec(rotation[a], moment)
+                _add_torque(out, a, rotation, moment)
+
+
+@njit(cache=True)
+def applied_forces(t, x, rotation, v, omega, mass, gravity, fixed, kinds, body_a, body_b,
+                   parameters):
+    """Gravity plus every force element at time ``t``: (nb, 6)."""
+    nb = mass.shape[0]
+    out = np.zeros((nb, 6))
+    for b in range(nb):
+        if not fixed[b]:
+            for i in range(3):
+                out[b, i] = mass[b] * gravity[i]
+    element_forces(t, x, rotation, v, omega, kinds, body_a, body_b, parameters, False, out)
+    for b in range(nb):
+        if fixed[b]:
+            out[b, :] = 0.0
+    return out
+
+
+@njit(cache=True)
+def spring_jacobians(t, x, p, v, omega, fixed, kinds, body_a, body_b, parameters,
+                     length_step):
+    """Stiffness K = dF/dxi and damping C = dF/dnu of the spring elements, (6 nb, 6 nb).
+
+    xi is the generalised displacement (world translation, body-axes rotation vector applied as
+    p * exp(dtheta)), nu the twist (v world, omega body). K by central differences with steps
+    ``length_step`` [L] and 1e-6 rad; C exactly by unit forward differences (spring forces are
+    affine in the velocities).
+    """
+    nb = x.shape[0]
+    n = 6 * nb
+    stiffness = np.zeros((n, n))
+    damping = np.zeros((n, n))
+    involved = np.zeros(nb, dtype=np.bool_)
+    for e in range(kinds.shape[0]):
+        if kinds[e] == FORCE_LINEAR_SPRING or kinds[e] == FORCE_TORSIONAL_SPRING:
+            involved[body_a[e]] = True
+            involved[body_b[e]] = True
+    rotation = rotation_matrices(p)
+    base = np.zeros((nb, 6))
+    element_forces(t, x, rotation, v, omega, kinds, body_a, body_b, parameters, True, base)
+    for b in range(nb):
+        if fixed[b] or not involved[b]:
+            continue
+        for k in range(6):
+            column = 6 * b + k
+            step = length_step if k < 3 else 1e-6
+            plus = np.zeros((nb, 6))
+            minus = np.zeros((nb, 6))
+            for sign in (1.0, -1.0):
+                xs = x.copy()
+                rs = rotation.copy()
+                if k < 3:
+                    xs[b, k] += sign * step
+                else:
+                    rv = np.zeros(3)
+                    rv[k - 3] = sign * step
+                    rs[b] = quat_to_matrix(quat_multiply(p[b], quat_exp(rv)))
+                target = plus if sign > 0 else minus
+                element_forces(t, xs, rs, v, omega, kinds, body_a, body_b, parameters, True,
+                               target)
+            for r in range(nb):
+                for i in range(6):
+                    stiffness[6 * r + i, column] = (plus[r, i] - minus[r, i]) / (2.0 * step)
+            vs = v.copy()
+            ws = omega.copy()
+            if k < 3:
+                vs[b, k] += 1.0
+            else:
+                ws[b, k - 3] += 1.0
+            bumped = np.zeros((nb, 6))
+            element_forces(t, x, rotation, vs, ws, kinds, body_a, body_b, parameters, True,
+                           bumped)
+            for r in range(nb):
+                for i in range(6):
+                    damping[6 * r + i, column] = bumped[r, i] - base[r, i]
+    for b in range(nb):
+        if fixed[b]:
+            stiffness[6 * b:6 * b + 6, :] = 0.0
+            damping[6 * b:6 * b + 6, :] = 0.0
+    return stiffness, damping
