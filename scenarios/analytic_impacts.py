@@ -363,7 +363,9 @@ def _exact_modulus(amplitude: np.ndarray, alpha: float) -> np.ndarray:
     return np.cos(0.5 * (alpha - amplitude)) ** 2
 
 
-def rocking_block_fall_time(amplitude, alpha: float, p: float, *, linearised: bool = False):
+def rocking_block_fall_time(
+    amplitude, alpha: float, p: float, *, linearised: bool = False
+) -> np.ndarray:
     """Time for the block to fall from rest at tilt ``amplitude`` back to theta = 0.
 
     Exact: ``F(phi, m) / p`` with ``m = cos^2((alpha - A)/2)`` and
@@ -402,7 +404,9 @@ def rocking_block_fall_time(amplitude, alpha: float, p: float, *, linearised: bo
     return ellipkinc(phi, m) / p
 
 
-def rocking_block_impact_speed(amplitude, alpha: float, p: float, *, linearised: bool = False):
+def rocking_block_impact_speed(
+    amplitude, alpha: float, p: float, *, linearised: bool = False
+) -> np.ndarray:
     """Angular speed |theta'| reached at theta = 0 after falling from rest at ``amplitude``.
 
     Exact: ``2 p sqrt(sin(alpha - A/2) sin(A/2))``; linearised: ``p sqrt(A (2 alpha - A))``.
@@ -595,7 +599,9 @@ def rocking_block_impact_times(
     return np.cumsum(durations)
 
 
-def rocking_block_angle(t, theta0: float, alpha: float, p: float, *, linearised: bool = False):
+def rocking_block_angle(
+    t, theta0: float, alpha: float, p: float, *, linearised: bool = False
+) -> np.ndarray:
     """Tilt angle theta(t) of a block released from rest at ``theta0``, through all impacts.
 
     Piecewise: each half-cycle is the time-symmetric rise and fall of the inverted-pendulum
@@ -626,7 +632,7 @@ def rocking_block_angle(t, theta0: float, alpha: float, p: float, *, linearised:
 
 def rocking_block_angular_velocity(
     t, theta0: float, alpha: float, p: float, *, linearised: bool = False
-):
+) -> np.ndarray:
     """Angular velocity theta'(t) matching :func:`rocking_block_angle`, right-continuous.
 
     Parameters
