@@ -20,9 +20,10 @@ import math
 
 import numpy as np
 import pytest
-from clearbench.scenarios import analytic
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, minimize_scalar
+
+from clearbench.scenarios import analytic
 
 EPS = np.finfo(float).eps
 RTOL = 1e-12  # solve_ivp relative tolerance used by every reference integration below
