@@ -1,0 +1,225 @@
+"""The reference engine: our nonsmooth Moreau–Jean solver with the combined projection.
+
+Presets (each a separate engine variant in results):
+
+- ``default``: theta = 1/2, combined projection on, NSGS with exact Alart–Curnier local solves,
+  tolerance 1e-12 (|F| / max(|q|, |r|, |u|)).
+- ``no-projection``: plain Moreau–Jean (Moreau's activation g + h/2 u_N <= 0).
+- ``newton``: as default with the semismooth Newton one-step solver.
+- ``implicit``: theta = 1 (more dissipative, unconditionally stable for stiff springs).
+
+Options (``RunSettings.options``) override: ``theta``, ``projection``, ``method``,
+``tolerance``, ``max_iterations``, ``position_tolerance``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from clearbench.ref_solver.contact_problem import SolverOptions
+from clearbench.ref_solver.stepper import MoreauJeanStepper, StepperSettings
+from clearbench.scenarios.quaternion import quat_to_matrix
+from clearbench.scenarios.scene import Scene
+
+from .base import Capability, Engine, RunSettings, Support
+from .reference_build import build_system, feature_lengths, initial_state
+from .trajectory import RunStatus, Trajectory
+
+PRESETS: dict[str, dict] = {
+    "default": {"theta": 0.5, "projection": True, "method": "nsgs"},
+    "no-projection": {"theta": 0.5, "projection": False, "method": "nsgs"},
+    "newton": {"theta": 0.5, "projection": True, "method": "newton"},
+    "implicit": {"theta": 1.0, "projection": True, "method": "nsgs"},
+}
+OPTION_NAMES = ("theta", "projection", "method", "tolerance", "max_iterations",
+                "position_tolerance")
+
+
+def availability() -> tuple[bool, str]:
+    import clearbench
+
+    return True, f"built in (clearbench {clearbench.__version__})"
+
+
+def create(preset: str = "default") -> ReferenceEngine:
+    return ReferenceEngine(preset)
+
+
+class ReferenceEngine(Engine):
+    """Our nonsmooth reference solver (see :mod:`clearbench.ref_solver.stepper`)."""
+
+    name = "reference"
+
+    def __init__(self, preset: str = "default"):
+        if preset not in PRESETS:
+            raise ValueError(f"unknown reference preset {preset!r}; presets: {list(PRESETS)}")
+        self.preset = preset
+
+    def capabilities(self, scene: Scene) -> dict[str, Capability]:
+        from clearbench.scenarios.geometry import supported_pair
+
+        out = {}
+        for feature in scene.features:
+            if feature.startswith("pair:"):
+                a, b = feature[5:].split("-")
+                ok = supported_pair(a, b)
+                out[feature] = Capability(
+                    Support.NATIVE if ok else Support.UNSUPPORTED,
+                    "closed-form gap" if ok else f"no gap function for {a} against {b}")
+            else:
+                out[feature] = Capability(Support.NATIVE, "exact (nonsmooth)")
+        return out
+
+    def stepper_settings(self, scene: Scene, settings: RunSettings) -> StepperSettings:
+        """Preset + options, with tolerances relative to the scene's smallest feature."""
+        options = dict(PRESETS[self.preset])
+        unknown = sorted(set(settings.options) - set(OPTION_NAMES))
+        if unknown:
+            raise ValueError(f"unknown reference options {unknown}; options: {OPTION_NAMES}")
+        options.update(settings.options)
+        lengths = feature_lengths(scene)
+        smallest = min(lengths) if lengths else 1.0
+        largest = max(lengths) if lengths else 1.0
+        solver = SolverOptions(method=options["method"],
+                               tolerance=float(options.get("tolerance", 1e-12)),
+                               max_iterations=int(options.get("max_iterations", 10_000)))
+        return StepperSettings(
+            time_step=settings.time_step or scene.time_step,
+            theta=float(options["theta"]),
+            projection=bool(options["projection"]),
+            solver=solver,
+            # 1e-10 of the smallest feature (a clearance, an offset, a radius): far below
+            # anything the metrics resolve, far above round-off of positions.
+            position_tolerance=float(options.get("position_tolerance", 1e-10 * smallest)),
+            activation_margin=1e-10 * smallest,
+            length_scale=largest,
+        )
+
+    def _run(self, scene: Scene, settings: RunSettings) -> Trajectory:
+        start = time.perf_counter()
+        system = build_system(scene)
+        config = self.stepper_settings(scene, settings)
+        stepper = MoreauJeanStepper(system, config)
+        state = initial_state(scene)
+        h = config.time_step
+        horizon = settings.horizon or scene.horizon
+        steps = int(math.ceil(horizon / h - 1e-9))
+        record = list(range(0, steps + 1, settings.record_every))
+        if record[-1] != steps:
+            record.append(steps)
+        recorder = _Recorder(scene, system, len(record), h)
+        recorder.store(0, state, None)
+        build_seconds = time.perf_counter() - start
+        status, message = RunStatus.OK, ""
+        next_record = 1
+        stepping = 0.0
+        taken = 0
+        for k in range(1, steps + 1):
+            tick = time.perf_counter()
+            result = stepper.step(state)
+            stepping += time.perf_counter() - tick
+            state = result.state
+            taken = k
+            finite = np.isfinite(state.x).all() and np.isfinite(state.v).all() and \
+                np.isfinite(state.omega).all()
+            recorder.accumulate(result)
+            if next_record < len(record) and (k == record[next_record] or not finite):
+                recorder.store(next_record, state, result)
+                next_record += 1
+            if not finite:
+                status, message = RunStatus.DIVERGED, f"non-finite state at step {k}"
+                break
+        trajectory = recorder.trajectory(next_record)
+        trajectory.engine = self.name
+        trajectory.preset = self.preset
+        trajectory.build_seconds = build_seconds
+        trajectory.stepping_seconds = stepping
+        trajectory.steps = taken
+        trajectory.status = status
+        trajectory.message = message
+        trajectory.metadata = {
+            "theta": config.theta, "projection": config.projection,
+            "solver": config.solver.method, "tolerance": config.solver.tolerance,
+            "position_tolerance": config.position_tolerance,
+            "unconverged_steps": recorder.unconverged,
+            "unconverged_projections": recorder.unconverged_projection,
+        }
+        return trajectory
+
+
+class _Recorder:
+    """Collects samples into preallocated arrays; statistics of skipped steps are
+    accumulated so that an unconverged step is never lost by subsampling."""
+
+    def __init__(self, scene: Scene, system, samples: int, h: float):
+        self.scene = scene
+        self.h = h
+        nb = system.body_count
+        npair = system.pair_count
+        self.com = np.array([b.center_of_mass for b in scene.bodies], dtype=float)
+        self.times = np.zeros(samples)
+        self.positions = np.zeros((samples, nb, 3))
+        self.orientations = np.zeros((samples, nb, 4))
+        self.velocities = np.zeros((samples, nb, 3))
+        self.omegas = np.zeros((samples, nb, 3))
+        self.normal = np.zeros((samples, npair))
+        self.force = np.zeros((samples, npair, 3))
+        self.iterations = np.zeros(samples, dtype=np.int64)
+        self.residual = np.full(samples, np.nan)
+        self.converged = np.ones(samples, dtype=bool)
+        self.active = np.zeros(samples, dtype=np.int64)
+        self.unconverged: list[int] = []
+        self.unconverged_projection: list[int] = []
+        self._iterations = 0
+        self._residual = 0.0
+        self._converged = True
+        self._step = 0
+
+    def accumulate(self, result) -> None:
+        self._step += 1
+        stats = result.statistics
+        self._iterations += stats.solver_iterations
+        self._residual = max(self._residual, stats.solver_residual)
+        if not stats.solver_converged:
+            self._converged = False
+            self.unconverged.append(self._step)
+        if not stats.projection_converged:
+            self.unconverged_projection.append(self._step)
+
+    def store(self, i: int, state, result) -> None:
+        self.times[i] = state.t
+        for b in range(state.x.shape[0]):
+            rotation = quat_to_matrix(state.p[b])
+            self.positions[i, b] = state.x[b] - rotation @ self.com[b]
+        self.orientations[i] = state.p
+        self.velocities[i] = state.v
+        self.omegas[i] = state.omega
+        if result is not None:
+            impulse = result.contact_impulse * result.contact_active[..., None]
+            self.normal[i] = impulse[..., 0].sum(axis=1) / self.h
+            world = np.einsum("pkr,pkrj->pkj", impulse, result.contact_frame)
+            self.force[i] = world.sum(axis=1) / self.h
+            self.iterations[i] = self._iterations
+            self.residual[i] = self._residual
+            self.converged[i] = self._converged
+            self.active[i] = result.statistics.active_contacts
+            self._iterations, self._residual, self._converged = 0, 0.0, True
+
+    def trajectory(self, count: int) -> Trajectory:
+        scene = self.scene
+        return Trajectory(
+            engine="", preset="", scene_name=scene.name, scene_hash=scene.content_hash,
+            units={"length": scene.units.length, "mass": scene.units.mass,
+                   "time": scene.units.time},
+            time_step=self.h, body_names=tuple(b.name for b in scene.bodies),
+            contact_names=tuple(c.name for c in scene.all_contacts),
+            times=self.times[:count], positions=self.positions[:count],
+            orientations=self.orientations[:count], velocities=self.velocities[:count],
+            angular_velocities=self.omegas[:count], contact_normal_force=self.normal[:count],
+            contact_force=self.force[:count], solver_iterations=self.iterations[:count],
+            solver_residual=self.residual[:count], solver_converged=self.converged[:count],
+            active_contacts=self.active[:count],
+        )

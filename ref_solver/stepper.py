@@ -1,0 +1,421 @@
+"""The Moreau–Jean time-stepper with the combined projection of the C-60 study.
+
+One step of length h from state k (Section 2.4 of Akhadkar, Acary, Brogliato 2018):
+
+1. Free velocity (theta-method). Forces F_k at t_k + theta h; springs linearised implicitly,
+   W = M - h theta C - h^2 theta^2 K, so stiff springs do not limit h; gyroscopic terms by the
+   momentum-conserving update of :mod:`.gyroscopic`.
+2. Velocity stage on the index set I: bilateral rows (joints, drivers) and the contacts of I
+   with Newton's impact law (u_N,k+1 + e u_N,k) and Coulomb friction as a second-order cone
+   complementarity problem (De Saxcé), solved by :func:`solve_contact_problem`.
+3. Position update x_{k+1} = x_k + h v_theta, p_{k+1} = p_k exp(h Omega_theta).
+4. Projection stage (``projection=True``): Newton iterations on the position constraints of
+   joints, translational drivers and the contacts of I: a mixed LCP in the multipliers delta
+   with the mass-weighted correction dq = M^-1 H^T delta, until every violation is below
+   ``position_tolerance``.
+5. Activation stage: I <- I U {alpha : g_alpha(q_{k+1}) <= 0}; when I grew, the step is redone
+   from state k (eq. 22). I starts as the contacts already closed at q_k (gap <= the activation
+   margin); without projection it starts as Moreau's prediction g + (h/2) u_N <= 0.
+
+Every step returns :class:`StepStatistics`; a one-step problem that does not converge is
+flagged there, never hidden.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from clearbench.scenarios.geometry import MAX_CONTACTS_PER_PAIR
+from clearbench.scenarios.quaternion import quat_integrate
+
+from .constraints import (
+    bilateral_rows,
+    contact_candidates,
+    contact_rows,
+    delassus,
+    row_values,
+)
+from .contact_problem import ContactProblem, SolverOptions
+from .fc3d_solve import solve_contact_problem
+from .forces import applied_forces, rotation_matrices, spring_jacobians
+from .gyroscopic import gyroscopic_update
+from .mlcp import solve_mlcp
+from .system import MultibodySystem, State
+
+
+@dataclass(frozen=True)
+class StepperSettings:
+    """Settings of :class:`MoreauJeanStepper` (lengths in the system's length unit).
+
+    Parameters
+    ----------
+    time_step : float
+        h [T], > 0.
+    theta : float
+        theta of the theta-method, in [1/2, 1].
+    projection : bool
+        Combined projection on (the study's scheme) or plain Moreau–Jean.
+    solver : SolverOptions
+        One-step contact solver (method, tolerance, iteration cap).
+    position_tolerance : float
+        Largest joint violation / contact penetration left by the projection [L].
+    max_projection_iterations, max_activation_rounds : int
+        Caps of the projection Newton loop and of the activation loop per step.
+    activation_margin : float
+        Contacts whose gap at the start of the step is below this are active from the start
+        of the step [L].
+    length_scale : float
+        Characteristic length [L] for finite-difference steps of the spring stiffness.
+    """
+
+    time_step: float
+    theta: float = 0.5
+    projection: bool = True
+    solver: SolverOptions = field(default_factory=lambda: SolverOptions(tolerance=1e-12))
+    position_tolerance: float = 1e-12
+    max_projection_iterations: int = 30
+    max_activation_rounds: int = 20
+    activation_margin: float = 1e-12
+    length_scale: float = 1.0
+
+    def __post_init__(self) -> None:
+        if not self.time_step > 0.0:
+            raise ValueError(f"time_step must be > 0, got {self.time_step!r}")
+        if not 0.5 <= self.theta <= 1.0:
+            raise ValueError(f"theta must be in [0.5, 1], got {self.theta!r}")
+        if not self.position_tolerance > 0.0:
+            raise ValueError(f"position_tolerance must be > 0, got {self.position_tolerance!r}")
+
+
+@dataclass(frozen=True)
+class StepStatistics:
+    """What one step did (iterations summed over activation rounds)."""
+
+    solver_iterations: int
+    solver_residual: float
+    solver_converged: bool
+    active_contacts: int
+    activation_rounds: int
+    projection_iterations: int
+    projection_violation: float
+    projection_converged: bool
+    gyroscopic_iterations: int
+
+
+@dataclass
+class StepResult:
+    """State at the end of the step, statistics and the impulses over the step.
+
+    ``contact_impulse`` (npair, K, 3) in each contact's frame (N, T1, T2) [F T];
+    ``contact_frame`` (npair, K, 3, 3) rows n, t1, t2; ``contact_point`` (npair, K, 3) world
+    point on shape B; ``contact_active`` (npair, K) bool.
+    """
+
+    state: State
+    statistics: StepStatistics
+    contact_impulse: np.ndarray
+    contact_frame: np.ndarray
+    contact_point: np.ndarray
+    contact_active: np.ndarray
+
+
+class MoreauJeanStepper:
+    """Advance a :class:`MultibodySystem` one step at a time (see module docstring)."""
+
+    def __init__(self, system: MultibodySystem, settings: StepperSettings):
+        self.system = system
+        self.settings = settings
+        nb = system.body_count
+        self.dof = 6 * nb
+        mass_matrix = np.zeros((self.dof, self.dof))
+        inverse = np.zeros((self.dof, self.dof))
+        for b in range(nb):
+            if system.body_fixed[b]:
+                continue
+            s = slice(6 * b, 6 * b + 3)
+            mass_matrix[s, s] = system.mass[b] * np.eye(3)
+            inverse[s, s] = np.eye(3) / system.mass[b]
+            r = slice(6 * b + 3, 6 * b + 6)
+            mass_matrix[r, r] = system.inertia[b]
+            inverse[r, r] = system.inverse_inertia[b]
+        self.mass_matrix = mass_matrix
+        self.inverse_mass = inverse
+        self._clusters(system)
+        npair = system.pair_count
+        k = MAX_CONTACTS_PER_PAIR
+        self.previous_impulse = np.zeros((npair, k, 3))
+        self.previous_bilateral = np.zeros(system.bilateral_row_count)
+        self.single_clusters = (np.arange(nb, dtype=np.int64),
+                                np.arange(6 * nb, dtype=np.int64),
+                                np.arange(0, 6 * nb + 1, 6, dtype=np.int64))
+
+    # ------------------------------------------------------------------ set-up
+    def _clusters(self, system: MultibodySystem) -> None:
+        """Bodies coupled by springs form clusters; the iteration matrix is block diagonal
+        over clusters (each body alone when there is no spring)."""
+        nb = system.body_count
+        parent = list(range(nb))
+
+        def root(i):
+            while parent[i] != i:
+                i = parent[i]
+            return i
+
+        if system.has_springs:
+            for a, b in zip(system.force_body_a, system.force_body_b, strict=True):
+                if a >= 0 and b >= 0 and not system.body_fixed[a] and not system.body_fixed[b]:
+                    parent[root(a)] = root(b)
+        roots = sorted({root(i) for i in range(nb)})
+        index = {r: c for c, r in enumerate(roots)}
+        cluster = np.array([index[root(i)] for i in range(nb)], dtype=np.int64)
+        dofs, start = [], [0]
+        for c in range(len(roots)):
+            for b in range(nb):
+                if cluster[b] == c:
+                    dofs.extend(range(6 * b, 6 * b + 6))
+            start.append(len(dofs))
+        self.cluster = cluster
+        self.cluster_dofs = np.array(dofs, dtype=np.int64)
+        self.cluster_start = np.array(start, dtype=np.int64)
+
+    # ------------------------------------------------------------------ one step
+    def step(self, state: State) -> StepResult:
+        """Advance ``state`` by one time step (``state`` is not modified)."""
+        sys_ = self.system
+        cfg = self.settings
+        h, theta = cfg.time_step, cfg.theta
+        rotation = rotation_matrices(state.p)
+        nu = np.concatenate((state.v, state.omega), axis=1)  # (nb, 6)
+
+        # 1. Free velocity.
+        t_theta = state.t + theta * h
+        forces = applied_forces(t_theta, state.x, rotation, state.v, state.omega, sys_.mass,
+                                sys_.gravity, sys_.body_fixed, sys_.force_kind,
+                                sys_.force_body_a, sys_.force_body_b, sys_.force_parameters)
+        rhs = h * forces.ravel()
+        inverse = self.inverse_mass
+        if sys_.has_springs:
+            stiffness, damping = spring_jacobians(
+                t_theta, state.x, state.p, state.v, state.omega, sys_.body_fixed,
+                sys_.force_kind, sys_.force_body_a, sys_.force_body_b, sys_.force_parameters,
+                1e-6 * cfg.length_scale)
+            iteration = self.mass_matrix - h * theta * damping - h * h * theta * theta * stiffness
+            rhs = rhs + h * h * theta * (stiffness @ nu.ravel())
+            inverse = self._cluster_inverse(iteration)
+        free = nu.ravel() + inverse @ rhs
+        omega_gyro, gyro_iterations = gyroscopic_update(
+            state.omega, sys_.inertia, sys_.inverse_inertia, sys_.body_fixed, h, theta)
+        free = free.reshape(-1, 6)
+        free[:, 3:] += omega_gyro - state.omega
+
+        # Contacts at q_k and their normal velocities.
+        cand = self._candidates(state.x, rotation)
+        gap_k = cand[0]
+        if cfg.projection:
+            active = self._slots(cand, gap_k <= cfg.activation_margin)
+        else:
+            u_normal = self._normal_velocity(state, rotation, cand, nu)
+            active = self._slots(cand, gap_k + 0.5 * h * u_normal <= cfg.activation_margin)
+
+        totals = dict(iterations=0, projection_iterations=0)
+        rounds = 0
+        while True:
+            rounds += 1
+            new_state, impulses, solve = self._velocity_stage(
+                state, rotation, nu, free, inverse, cand, active)
+            projection = (0, 0.0, True)
+            if cfg.projection:
+                projection = self._projection_stage(new_state, active)
+            totals["iterations"] += solve.iterations
+            totals["projection_iterations"] += projection[0]
+            if not cfg.projection:
+                break
+            rotation_new = rotation_matrices(new_state.p)
+            cand_new = self._candidates(new_state.x, rotation_new)
+            closing = self._slots(cand_new, cand_new[0] <= 0.0) & ~active
+            if not closing.any() or rounds >= cfg.max_activation_rounds:
+                break
+            active = active | closing
+        self.previous_impulse[:] = 0.0
+        self.previous_impulse[active] = impulses[active]
+        stats = StepStatistics(
+            solver_iterations=totals["iterations"], solver_residual=float(solve.residual),
+            solver_converged=bool(solve.converged), active_contacts=int(active.sum()),
+            activation_rounds=rounds, projection_iterations=totals["projection_iterations"],
+            projection_violation=float(projection[1]),
+            projection_converged=bool(projection[2]), gyroscopic_iterations=int(gyro_iterations),
+        )
+        return StepResult(new_state, stats, impulses, cand[3], cand[2], active)
+
+    # ------------------------------------------------------------------ pieces
+    def _cluster_inverse(self, matrix: np.ndarray) -> np.ndarray:
+        out = np.zeros_like(matrix)
+        for c in range(len(self.cluster_start) - 1):
+            dofs = self.cluster_dofs[self.cluster_start[c]:self.cluster_start[c + 1]]
+            block = matrix[np.ix_(dofs, dofs)]
+            if not block.any():
+                continue
+            out[np.ix_(dofs, dofs)] = np.linalg.inv(block)
+        fixed = np.repeat(self.system.body_fixed, 6)
+        out[fixed, :] = 0.0
+        out[:, fixed] = 0.0
+        return out
+
+    def _candidates(self, x, rotation):
+        sys_ = self.system
+        npair = sys_.pair_count
+        k = MAX_CONTACTS_PER_PAIR
+        gap = np.full((npair, k), np.inf)
+        point_a = np.zeros((npair, k, 3))
+        point_b = np.zeros((npair, k, 3))
+        frame = np.zeros((npair, k, 3, 3))
+        count = np.zeros(npair, dtype=np.int64)
+        if npair:
+            contact_candidates(x, rotation, sys_.shape_kind, sys_.shape_parameters,
+                               sys_.shape_body, sys_.shape_position, sys_.shape_rotation,
+                               sys_.pair_shape_a, sys_.pair_shape_b, sys_.pair_offset, gap,
+                               point_a, point_b, frame, count)
+        return gap, point_a, point_b, frame, count
+
+    @staticmethod
+    def _slots(cand, mask):
+        count = cand[4]
+        valid = np.arange(mask.shape[1])[None, :] < count[:, None]
+        return mask & valid
+
+    def _rows(self, t, x, p, rotation, cand, active):
+        """Bilateral rows then 3 rows per active contact."""
+        sys_ = self.system
+        nbil = sys_.bilateral_row_count
+        pairs, slots = np.nonzero(active)
+        m = nbil + 3 * len(pairs)
+        row_body = np.full((m, 2), -1, dtype=np.int64)
+        row_coef = np.zeros((m, 2, 6))
+        violation = np.zeros(m)
+        target = np.zeros(m)
+        if nbil:
+            bilateral_rows(t, x, p, rotation, sys_.body_fixed, sys_.joint_kind,
+                           sys_.joint_body_a, sys_.joint_body_b, sys_.joint_anchor_a,
+                           sys_.joint_anchor_b, sys_.joint_frame_a, sys_.joint_axis_b,
+                           sys_.joint_relative_rotation, sys_.driver_body,
+                           sys_.driver_component, sys_.driver_quantity, sys_.driver_start,
+                           sys_.driver_times, sys_.driver_values, sys_.driver_initial,
+                           row_body, row_coef, violation, target)
+        if len(pairs):
+            contact_rows(x, rotation, sys_.body_fixed, sys_.shape_body, sys_.pair_shape_a,
+                         sys_.pair_shape_b, pairs.astype(np.int64), slots.astype(np.int64),
+                         cand[1], cand[2], cand[3], row_body, row_coef, nbil)
+            violation[nbil:][0::3] = cand[0][pairs, slots]
+        return row_body, row_coef, violation, target, pairs, slots
+
+    def _normal_velocity(self, state, rotation, cand, nu):
+        every = self._slots(cand, np.ones_like(cand[0], dtype=bool))
+        out = np.zeros_like(cand[0])
+        if not every.any():
+            return out
+        rows = self._rows(state.t, state.x, state.p, rotation, cand, every)
+        nbil = self.system.bilateral_row_count
+        values = row_values(rows[0], rows[1], nu, nbil, rows[0].shape[0])
+        out[rows[4], rows[5]] = values[0::3]
+        return out
+
+    def _velocity_stage(self, state, rotation, nu, free, inverse, cand, active):
+        sys_ = self.system
+        cfg = self.settings
+        h, theta = cfg.time_step, cfg.theta
+        t1 = state.t + h
+        row_body, row_coef, _, target, pairs, slots = self._rows(
+            t1, state.x, state.p, rotation, cand, active)
+        nbil = sys_.bilateral_row_count
+        m = row_body.shape[0]
+        new_nu = free.copy()
+        impulses = np.zeros_like(self.previous_impulse)
+        if m:
+            w, y = delassus(row_body, row_coef, m, inverse, self.cluster,
+                            self.cluster_dofs, self.cluster_start)
+            q = row_values(row_body, row_coef, free, 0, m) - target
+            if len(pairs):
+                u_k = row_values(row_body, row_coef, nu, nbil, m)[0::3]
+                e = sys_.pair_restitution[pairs]
+                q[nbil:][0::3] += e * np.minimum(u_k, 0.0)
+            r0 = np.concatenate((self.previous_bilateral,
+                                 self.previous_impulse[pairs, slots].ravel()))
+            problem = ContactProblem(w, q, sys_.pair_friction[pairs], n_bilateral=nbil)
+            solve = solve_contact_problem(problem, cfg.solver, r0=r0)
+            new_nu = free + (y @ solve.r).reshape(-1, 6)
+            self.previous_bilateral = solve.r[:nbil].copy()
+            impulses[pairs, slots] = solve.r[nbil:].reshape(-1, 3)
+        else:
+            solve = _NO_SOLVE
+        new_nu[sys_.body_fixed] = 0.0
+        v_theta = theta * new_nu + (1.0 - theta) * nu
+        x_new = state.x + h * v_theta[:, :3]
+        p_new = state.p.copy()
+        for b in range(sys_.body_count):
+            if not sys_.body_fixed[b]:
+                p_new[b] = quat_integrate(state.p[b], h * v_theta[b, 3:])
+        new_state = State(t1, x_new, p_new, new_nu[:, :3].copy(), new_nu[:, 3:].copy())
+        return new_state, impulses, solve
+
+    def _projection_stage(self, state: State, active) -> tuple[int, float, bool]:
+        """Project positions onto the joint, driver and active-contact constraints in place.
+
+        Returns (iterations, largest remaining violation [L], converged)."""
+        sys_ = self.system
+        cfg = self.settings
+        nbil = sys_.bilateral_row_count
+        rotation_driver = sys_.driver_component >= 3
+        worst = 0.0
+        for iteration in range(cfg.max_projection_iterations + 1):
+            rotation = rotation_matrices(state.p)
+            cand = self._candidates(state.x, rotation)
+            row_body, row_coef, violation, _, pairs, slots = self._rows(
+                state.t, state.x, state.p, rotation, cand, active)
+            keep = np.ones(row_body.shape[0], dtype=bool)
+            if nbil:
+                joint_rows = nbil - len(sys_.driver_body)
+                keep[joint_rows:nbil] = ~rotation_driver
+            # Contacts: only the normal rows take part in the projection.
+            if len(pairs):
+                contact_part = np.zeros(3 * len(pairs), dtype=bool)
+                contact_part[0::3] = True
+                keep[nbil:] = contact_part
+            rows = np.nonzero(keep)[0]
+            n_equal = int(np.count_nonzero(rows < nbil))
+            values = violation[rows]
+            equal_error = np.max(np.abs(values[:n_equal])) if n_equal else 0.0
+            unilateral_error = max(0.0, -np.min(values[n_equal:])) if len(values) > n_equal \
+                else 0.0
+            worst = max(equal_error, unilateral_error)
+            if worst <= cfg.position_tolerance or len(rows) == 0:
+                return iteration, worst, True
+            if iteration == cfg.max_projection_iterations:
+                break
+            rb = np.ascontiguousarray(row_body[rows])
+            rc = np.ascontiguousarray(row_coef[rows])
+            w, y = delassus(rb, rc, len(rows), self.inverse_mass, *self.single_clusters)
+            # Contacts already separated enough need no correction; keep them in the MLCP (their
+            # multiplier is zero) so that the set stays the active set of the step.
+            mlcp = solve_mlcp(w, values, n_equal, tolerance=1e-14,
+                              max_iterations=1000)
+            delta = (y @ mlcp.z).reshape(-1, 6)
+            state.x += delta[:, :3]
+            for b in range(sys_.body_count):
+                if not sys_.body_fixed[b]:
+                    state.p[b] = quat_integrate(state.p[b], delta[b, 3:])
+        return cfg.max_projection_iterations, worst, False
+
+
+@dataclass(frozen=True)
+class _NoSolve:
+    iterations: int = 0
+    residual: float = 0.0
+    converged: bool = True
+    r: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+
+_NO_SOLVE = _NoSolve()
+_CLOCK = time.perf_counter
