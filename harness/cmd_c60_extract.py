@@ -33,7 +33,12 @@ def register(subparsers) -> None:
     parser = subparsers.add_parser(
         "c60-extract",
         help="extract the C-60 contact primitives from the STEP files (needs the 'cad' extra)",
-        description=__doc__.split("\n\n")[1],
+        description=(
+            "Re-extract the primitives of the C-60 STEP files named by the data sheet and write "
+            "scenarios/data/c60/primitives.json, or with --check compare them with that file "
+            "and exit with status 1 on a difference beyond the tolerance. Needs the optional "
+            "extra 'cad' (cadquery-ocp)."
+        ),
     )
     parser.add_argument("--check", action="store_true",
                         help="compare with the committed file instead of writing it")
