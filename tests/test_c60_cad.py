@@ -14,6 +14,7 @@ import sys
 import tomllib
 
 import pytest
+
 from clearbench.harness.cli import main
 from clearbench.scenarios.c60_primitives import (
     PRIMITIVES_PATH,
