@@ -33,6 +33,8 @@ _ARMIJO = 1e-4
 _MAX_HALVINGS = 30
 _RESCUE_SWEEPS = 10
 _MAX_RESCUES = 50
+_DELTA_MIN = 1e-12
+_DELTA_MAX = 1e-3
 
 
 @njit(cache=True)
@@ -63,6 +65,28 @@ def _block_diagonal(n_bilateral: int, bilateral_diagonal: np.ndarray, blocks: np
     if n_bilateral == 0:
         return contact_part.tocsc()
     return sp.block_diag([sp.diags(bilateral_diagonal), contact_part], format="csc")
+
+
+def _regularised_direction(J, phi: np.ndarray, residual: float) -> np.ndarray | None:
+    """Solve (J + delta I) d = -Phi; None if no finite solution.
+
+    W (hence J) is singular on redundant contact sets (four contacts under a box face give 12
+    rows for 6 degrees of freedom). The proximal term delta I (J is dimensionless) picks a
+    bounded direction; delta shrinks with the residual (Levenberg–Marquardt style, which keeps
+    fast local convergence) and grows when the factorisation fails.
+    """
+    identity = sp.identity(J.shape[0], format="csc")
+    delta = min(_DELTA_MAX, max(_DELTA_MIN, residual))
+    for _ in range(6):
+        try:
+            with np.errstate(all="ignore"):
+                d = spla.splu((J + delta * identity).tocsc()).solve(-phi)
+            if np.all(np.isfinite(d)):
+                return d
+        except RuntimeError:  # exactly singular
+            pass
+        delta *= 100.0
+    return None
 
 
 def solve_newton(
@@ -118,13 +142,8 @@ def solve_newton(
         merit = alart_curnier_system(r, u, mu, nb, rho_n, rho_t, rho_b, phi, A, B, True)
         J = (_block_diagonal(nb, np.zeros(nb), A)
              + _block_diagonal(nb, rho_b, B) @ W).tocsc()
-        step_ok = False
-        try:
-            with np.errstate(all="ignore"):
-                d = spla.splu(J).solve(-phi)
-            step_ok = bool(np.all(np.isfinite(d)))
-        except RuntimeError:  # exactly singular J
-            step_ok = False
+        d = _regularised_direction(J, phi, residual)
+        step_ok = d is not None
         if step_ok:
             step = 1.0
             step_ok = False
