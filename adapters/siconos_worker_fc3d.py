@@ -10,7 +10,8 @@ Protocol (files, never stdout, which Siconos fills with noise):
 INPUT.npz holds ``W_indptr``, ``W_indices``, ``W_data`` (CSR of W, shape (m, m)), ``q`` (m,),
 ``mu`` (nc,), ``mode`` ("solve" or "error"), and for "solve": ``solver`` ("nsgs-ac" or
 "nsn-ac"), ``storage`` ("dense" or "sparse-block"), ``tolerance``, ``max_iterations``, optional
-``r0`` (m,) warm start; for "error": ``r`` (m,) whose residual Siconos evaluates.
+``r0`` (m,) warm start and ``repeat`` (solve that many times, report the fastest); for
+"error": ``r`` (m,) whose residual Siconos evaluates.
 
 OUTPUT.npz holds ``ok`` (bool), ``message``, and for "solve": ``r``, ``u``, ``info`` (Siconos's
 return code, 0 = converged), ``iterations``, ``error`` (Siconos's own residual,
@@ -94,11 +95,14 @@ def solve(sn, inputs):
     options.iparam[sn.SICONOS_IPARAM_MAX_ITER] = int(inputs["max_iterations"])
     options.dparam[sn.SICONOS_DPARAM_TOL] = float(inputs["tolerance"])
     m = int(inputs["q"].size)
-    r = np.array(inputs["r0"], dtype=np.float64) if "r0" in inputs.files else np.zeros(m)
-    u = np.zeros(m)
-    start = time.perf_counter()
-    info = sn.fc3d_driver(problem, r, u, options)
-    wall_time = time.perf_counter() - start
+    repeat = int(inputs["repeat"]) if "repeat" in inputs.files else 1
+    wall_time = float("inf")
+    for _ in range(max(repeat, 1)):  # same start each time; the fastest run is reported
+        r = np.array(inputs["r0"], dtype=np.float64) if "r0" in inputs.files else np.zeros(m)
+        u = np.zeros(m)
+        start = time.perf_counter()
+        info = sn.fc3d_driver(problem, r, u, options)
+        wall_time = min(wall_time, time.perf_counter() - start)
     return {
         "r": r, "u": u, "info": int(info),
         "iterations": int(options.iparam[sn.SICONOS_IPARAM_ITER_DONE]),

@@ -15,6 +15,7 @@ import sys
 #: Modules that each add one or more sub-commands (``register(subparsers)``).
 COMMAND_MODULES: tuple[str, ...] = (
     "clearbench.harness.cmd_scenes",
+    "clearbench.harness.cmd_fclib",
 )
 
 

@@ -20,7 +20,6 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-
 from clearbench.ref_solver.contact_problem import ContactProblem
 
 

@@ -216,6 +216,8 @@ class SolverResult:
         Human-readable detail on a failure.
     local_failures : int
         NSGS: local solves that ended above the local tolerance (last sweep).
+    history : ndarray
+        Normalised residual at each check (NSGS) or Newton iteration.
     """
 
     r: np.ndarray
@@ -229,4 +231,4 @@ class SolverResult:
     method: str
     message: str = ""
     local_failures: int = 0
-    history: tuple[float, ...] = field(default_factory=tuple)
+    history: np.ndarray = field(default_factory=lambda: np.zeros(0))

@@ -247,7 +247,8 @@ def fischer_burmeister(
     for j in range(3):
         dxj = mu if j == 0 else 1.0
         for i in range(3):
-            col[i] = Lx[i, j] * dxj + Ly[i, 0] * Dy[0, j] + Ly[i, 1] * Dy[1, j] + Ly[i, 2] * Dy[2, j]
+            col[i] = (Lx[i, j] * dxj + Ly[i, 0] * Dy[0, j] + Ly[i, 1] * Dy[1, j]
+                      + Ly[i, 2] * Dy[2, j])
         if not solve3(Lw, col, sol, mat[_LU]):
             sol[0] = 0.0
             sol[1] = 0.0

@@ -4,7 +4,7 @@ Unknown r (m,). Equation Phi(r) = 0 with, per contact, the Alart–Curnier funct
 :func:`fc3d_local.alart_curnier` (rho_N = 1 / W_ii[N, N], rho_T = 1 / max(W_ii[T1, T1],
 W_ii[T2, T2])) and, per bilateral row b, Phi_b = u_b / W_bb (so that all rows have impulse
 units). A generalised Jacobian is J = A + B W with A, B block diagonal; each iteration solves
-J d = -Phi by a sparse LU and takes an Armijo step on 0.5 |Phi|^2.
+J d = -Phi by LU (dense up to 100 rows, sparse above) and takes an Armijo step on 0.5 |Phi|^2.
 
 When no descent step exists (a kink of Phi, or a singular J), a few NSGS sweeps are run from the
 current iterate and Newton resumes (the hybrid strategy Siconos also uses); the run stops as
@@ -22,7 +22,13 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numba import njit
 
-from .contact_problem import ContactProblem, Normalisation, SolverOptions, SolverResult, SolverStatus
+from .contact_problem import (
+    ContactProblem,
+    Normalisation,
+    SolverOptions,
+    SolverResult,
+    SolverStatus,
+)
 from .fc3d_local import LOCAL_KIND, alart_curnier
 from .fc3d_nsgs import bilateral_solve_operator, diagonal_blocks, nsgs_kernel
 from .fc3d_residual import residual_both
@@ -34,6 +40,7 @@ _MAX_HALVINGS = 30
 _RESCUE_SWEEPS = 10
 _MAX_RESCUES = 50
 _DELTA_MIN = 1e-12
+_DENSE_LIMIT = 100  # rows; below, dense LU beats scipy.sparse overhead
 _DELTA_MAX = 1e-3
 
 
@@ -56,6 +63,26 @@ def alart_curnier_system(
     return 0.5 * merit
 
 
+@njit(cache=True)
+def dense_jacobian(W: np.ndarray, n_bilateral: int, rho_b: np.ndarray, A: np.ndarray,
+                   B: np.ndarray, delta: float, J: np.ndarray) -> None:
+    """J = A + B W + delta I as a dense (m, m) array (A, B block diagonal, W dense)."""
+    m = W.shape[0]
+    for b in range(n_bilateral):
+        for col in range(m):
+            J[b, col] = rho_b[b] * W[b, col]
+        J[b, b] += delta
+    for i in range(A.shape[0]):
+        k = n_bilateral + 3 * i
+        for a in range(3):
+            for col in range(m):
+                J[k + a, col] = B[i, a, 0] * W[k, col] + B[i, a, 1] * W[k + 1, col] \
+                    + B[i, a, 2] * W[k + 2, col]
+            for c in range(3):
+                J[k + a, k + c] += A[i, a, c]
+            J[k + a, k + a] += delta
+
+
 def _block_diagonal(n_bilateral: int, bilateral_diagonal: np.ndarray, blocks: np.ndarray):
     """Sparse (m, m) matrix diag(bilateral_diagonal) ⊕ blocks[0] ⊕ ... ⊕ blocks[nc - 1]."""
     nc = blocks.shape[0]
@@ -65,6 +92,21 @@ def _block_diagonal(n_bilateral: int, bilateral_diagonal: np.ndarray, blocks: np
     if n_bilateral == 0:
         return contact_part.tocsc()
     return sp.block_diag([sp.diags(bilateral_diagonal), contact_part], format="csc")
+
+
+def _regularised_direction_dense(W_dense, nb, rho_b, A, B, phi, residual, J):
+    """Dense counterpart of :func:`_regularised_direction` (small problems)."""
+    delta = min(_DELTA_MAX, max(_DELTA_MIN, residual))
+    for _ in range(6):
+        dense_jacobian(W_dense, nb, rho_b, A, B, delta, J)
+        try:
+            d = np.linalg.solve(J, -phi)
+            if np.all(np.isfinite(d)):
+                return d
+        except np.linalg.LinAlgError:
+            pass
+        delta *= 100.0
+    return None
 
 
 def _regularised_direction(J, phi: np.ndarray, residual: float) -> np.ndarray | None:
@@ -113,6 +155,8 @@ def solve_newton(
     A_try = np.zeros((nc, 3, 3))
     B_try = np.zeros((nc, 3, 3))
     bilateral_operator = None
+    W_dense = problem.W_dense() if m <= _DENSE_LIMIT else None
+    J_dense = np.empty((m, m)) if W_dense is not None else None
     history: list[float] = []
     rescues = 0
     best_residual = np.inf
@@ -140,9 +184,12 @@ def solve_newton(
             break
         iteration += 1
         merit = alart_curnier_system(r, u, mu, nb, rho_n, rho_t, rho_b, phi, A, B, True)
-        J = (_block_diagonal(nb, np.zeros(nb), A)
-             + _block_diagonal(nb, rho_b, B) @ W).tocsc()
-        d = _regularised_direction(J, phi, residual)
+        if W_dense is not None:
+            d = _regularised_direction_dense(W_dense, nb, rho_b, A, B, phi, residual, J_dense)
+        else:
+            J = (_block_diagonal(nb, np.zeros(nb), A)
+                 + _block_diagonal(nb, rho_b, B) @ W).tocsc()
+            d = _regularised_direction(J, phi, residual)
         step_ok = d is not None
         if step_ok:
             step = 1.0
@@ -188,5 +235,5 @@ def solve_newton(
         residual_q=float(residual_q), residual_max=float(residual_max),
         converged=status is SolverStatus.CONVERGED, status=status, method="newton-ac",
         message=message + (f" ({rescues} NSGS rescues)" if rescues else ""),
-        history=tuple(history),
+        history=np.array(history),
     )

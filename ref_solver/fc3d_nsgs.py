@@ -17,9 +17,15 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
-from .contact_problem import ContactProblem, Normalisation, SolverOptions, SolverResult, SolverStatus
+from .contact_problem import (
+    ContactProblem,
+    Normalisation,
+    SolverOptions,
+    SolverResult,
+    SolverStatus,
+)
 from .fc3d_local import LOCAL_FAILED, LOCAL_KIND, N_MAT, N_VEC, solve_local
-from .fc3d_residual import csr_matvec_plus, natural_map_squared, normalised, residual_both
+from .fc3d_residual import csr_matvec_plus, natural_map_squared, normalised
 
 logger = logging.getLogger(__name__)
 
@@ -29,6 +35,7 @@ _STATUS_CODES = (
     SolverStatus.STALLED,
     SolverStatus.NUMERICAL_FAILURE,
 )
+_NO_OPERATOR = np.zeros((0, 0))
 
 
 def diagonal_blocks(W_csr: sp.csr_matrix, n_bilateral: int, n_contacts: int) -> np.ndarray:
@@ -71,23 +78,25 @@ def nsgs_kernel(
     u: np.ndarray, kind: int, tolerance: float, use_max: bool, max_sweeps: int,
     local_tolerance: float, local_max_iterations: int, check_interval: int,
     history: np.ndarray,
-) -> tuple[int, int, float, int]:
+) -> tuple[int, int, float, float, float, float, int, int]:
     """Run NSGS sweeps on r (in place); u receives W r + q at the last residual check.
 
-    Returns (status code: 0 converged / 1 max iterations / 3 NaN, sweeps done, residual in the
-    requested normalisation, local failures in the last sweep). ``history`` (max_sweeps,)
-    receives the residual at each check (NaN elsewhere).
+    The last sweep is always checked. Returns (status code: 0 converged / 1 max iterations /
+    3 non-finite, sweeps done, |F|, |q|, |r|, |u|, local failures in the last sweep, number of
+    checks). ``history`` (>= max_sweeps,) receives the normalised residual of each check.
     """
-    m = q.size
     nc = mu.size
     vec = np.zeros((N_VEC, 3))
     mat = np.zeros((N_MAT, 3, 3))
     ql = np.zeros(3)
     ri = np.zeros(3)
     rhs = np.zeros(n_bilateral)
-    norm_q = math.sqrt(np.sum(q * q))
-    residual = np.inf
+    norm_q = math.sqrt(np.dot(q, q))
+    abs_residual = np.inf
+    norm_r = 0.0
+    norm_u = 0.0
     failures = 0
+    n_checks = 0
     for sweep in range(max_sweeps):
         # bilateral rows, exact: W_bb r_b = -(q_b + W_bc r_c)
         if n_bilateral > 0:
@@ -121,20 +130,19 @@ def nsgs_kernel(
             r[k] = ri[0]
             r[k + 1] = ri[1]
             r[k + 2] = ri[2]
-        last = sweep == max_sweeps - 1
-        if (sweep + 1) % check_interval == 0 or last:
+        if (sweep + 1) % check_interval == 0 or sweep == max_sweeps - 1:
             csr_matvec_plus(indptr, indices, data, r, q, u)
             abs_residual = math.sqrt(natural_map_squared(r, u, mu, n_bilateral))
-            if not math.isfinite(abs_residual):
-                return 3, sweep + 1, np.nan, failures
-            residual = normalised(abs_residual, norm_q, math.sqrt(np.sum(r * r)),
-                                  math.sqrt(np.sum(u * u)), use_max)
-            history[sweep] = residual
+            norm_r = math.sqrt(np.dot(r, r))
+            norm_u = math.sqrt(np.dot(u, u))
+            if not math.isfinite(abs_residual + norm_r + norm_u):
+                return 3, sweep + 1, np.nan, norm_q, norm_r, norm_u, failures, n_checks
+            residual = normalised(abs_residual, norm_q, norm_r, norm_u, use_max)
+            history[n_checks] = residual
+            n_checks += 1
             if residual <= tolerance:
-                return 0, sweep + 1, residual, failures
-    if m == 0:
-        return 0, 0, 0.0, 0
-    return 1, max_sweeps, residual, failures
+                return 0, sweep + 1, abs_residual, norm_q, norm_r, norm_u, failures, n_checks
+    return 1, max_sweeps, abs_residual, norm_q, norm_r, norm_u, failures, n_checks
 
 
 def solve_nsgs(
@@ -144,39 +152,36 @@ def solve_nsgs(
     W = problem.W_csr()
     nb, nc = problem.n_bilateral, problem.n_contacts
     blocks = diagonal_blocks(W, nb, nc)
-    operator = bilateral_solve_operator(problem.W_dense()[:nb, :nb] if nb else np.zeros((0, 0)))
+    operator = bilateral_solve_operator(problem.W_dense()[:nb, :nb]) if nb else _NO_OPERATOR
     r = np.zeros(problem.size) if r0 is None else np.array(r0, dtype=np.float64, copy=True)
     if r.shape != (problem.size,):
         raise ValueError(f"r0 must have shape ({problem.size},), got {r.shape}")
-    u = np.empty(problem.size)
-    history = np.full(options.max_iterations, np.nan)
-    use_max = Normalisation(options.normalisation) is Normalisation.MAX
     if problem.size == 0:
-        return _result(problem, r, problem.q.copy(), 0, 0, 0, options, history, 0)
-    code, sweeps, residual, failures = nsgs_kernel(
-        W.indptr.astype(np.int64), W.indices.astype(np.int64), W.data, problem.q, problem.mu,
-        nb, blocks, operator, r, u, LOCAL_KIND[options.local_solver], options.tolerance,
-        use_max, options.max_iterations, options.local_tolerance,
-        options.local_max_iterations, options.residual_check_interval, history,
+        return SolverResult(r=r, u=r.copy(), iterations=0, residual=0.0, residual_q=0.0,
+                            residual_max=0.0, converged=True, status=SolverStatus.CONVERGED,
+                            method=f"nsgs-{options.local_solver}")
+    u = np.empty(problem.size)
+    history = np.empty(options.max_iterations)  # untouched pages cost nothing
+    use_max = Normalisation(options.normalisation) is Normalisation.MAX
+    code, sweeps, abs_residual, norm_q, norm_r, norm_u, failures, n_checks = nsgs_kernel(
+        W.indptr, W.indices, W.data, problem.q, problem.mu, nb, blocks, operator, r, u,
+        LOCAL_KIND[options.local_solver], options.tolerance, use_max, options.max_iterations,
+        options.local_tolerance, options.local_max_iterations, options.residual_check_interval,
+        history,
     )
-    return _result(problem, r, u, code, sweeps, residual, options, history, failures)
-
-
-def _result(problem, r, u, code, sweeps, residual, options, history, failures) -> SolverResult:
     status = _STATUS_CODES[code]
-    if status is SolverStatus.NUMERICAL_FAILURE:
-        residual_q = residual_max = float("nan")
-    else:
-        u = problem.velocity(r)
-        _, residual_q, residual_max = residual_both(r, u, problem.q, problem.mu, problem.n_bilateral)
+    residual_q = normalised(abs_residual, norm_q, norm_r, norm_u, False)
+    residual_max = normalised(abs_residual, norm_q, norm_r, norm_u, True)
     message = ""
     if status is SolverStatus.MAX_ITERATIONS:
-        message = f"{sweeps} sweeps done, residual {residual:.3g} > {options.tolerance:.3g}"
+        message = f"{sweeps} sweeps done, residual {history[n_checks - 1]:.3g} > " \
+                  f"{options.tolerance:.3g}"
     elif status is SolverStatus.NUMERICAL_FAILURE:
         message = f"non-finite residual after {sweeps} sweeps"
     return SolverResult(
-        r=r, u=u, iterations=int(sweeps), residual=float(residual), residual_q=residual_q,
-        residual_max=residual_max, converged=status is SolverStatus.CONVERGED, status=status,
+        r=r, u=u, iterations=int(sweeps), residual=residual_max if use_max else residual_q,
+        residual_q=residual_q, residual_max=residual_max,
+        converged=status is SolverStatus.CONVERGED, status=status,
         method=f"nsgs-{options.local_solver}", message=message, local_failures=int(failures),
-        history=tuple(float(h) for h in history[:sweeps] if np.isfinite(h)),
+        history=history[:n_checks].copy(),
     )
