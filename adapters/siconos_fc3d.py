@@ -100,3 +100,15 @@ def siconos_compute_error(problem: ContactProblem, r: np.ndarray, timeout: float
     if outcome.status is not WorkerStatus.OK:
         raise RuntimeError(f"Siconos worker {outcome.status.value}: {outcome.message}")
     return float(outcome.outputs["error"])
+
+
+def siconos_read_text_file(path: str | Path, timeout: float = 120.0) -> dict[str, np.ndarray]:
+    """Siconos's own reading of a Siconos text problem file: {"W" (m, m) dense, "q", "mu"}.
+
+    Raises RuntimeError if the worker does not answer.
+    """
+    outcome = run_worker(WORKER_SCRIPT, {"mode": "read", "path": str(Path(path).resolve())},
+                         timeout=timeout)
+    if outcome.status is not WorkerStatus.OK:
+        raise RuntimeError(f"Siconos worker {outcome.status.value}: {outcome.message}")
+    return {key: outcome.outputs[key] for key in ("W", "q", "mu")}

@@ -8,10 +8,11 @@ Protocol (files, never stdout, which Siconos fills with noise):
     /usr/bin/python3 siconos_worker_fc3d.py INPUT.npz OUTPUT.npz
 
 INPUT.npz holds ``W_indptr``, ``W_indices``, ``W_data`` (CSR of W, shape (m, m)), ``q`` (m,),
-``mu`` (nc,), ``mode`` ("solve" or "error"), and for "solve": ``solver`` ("nsgs-ac" or
+``mu`` (nc,), ``mode`` ("solve", "error" or "read"), and for "solve": ``solver`` ("nsgs-ac" or
 "nsn-ac"), ``storage`` ("dense" or "sparse-block"), ``tolerance``, ``max_iterations``, optional
 ``r0`` (m,) warm start and ``repeat`` (solve that many times, report the fastest); for
-"error": ``r`` (m,) whose residual Siconos evaluates.
+"error": ``r`` (m,) whose residual Siconos evaluates. Mode "read" takes only ``path`` (a
+Siconos text file) and returns Siconos's reading of it: ``W`` (dense), ``q``, ``mu``.
 
 OUTPUT.npz holds ``ok`` (bool), ``message``, and for "solve": ``r``, ``u``, ``info`` (Siconos's
 return code, 0 = converged), ``iterations``, ``error`` (Siconos's own residual,
@@ -121,6 +122,15 @@ def compute_error(sn, inputs):
     return {"error": float(error), "u": u}
 
 
+def read_file(sn, inputs):
+    """Siconos's own reading of a Siconos text file (dense W, q, mu) - to cross-check ours."""
+    problem = sn.frictionContact_new_from_filename(str(inputs["path"]))
+    matrix = problem.M
+    m = int(matrix.size0)
+    W = np.array([[sn.NM_get_value(matrix, i, j) for j in range(m)] for i in range(m)])
+    return {"W": W, "q": np.array(problem.q), "mu": np.array(problem.mu)}
+
+
 def main(argv):
     input_path, output_path = argv[1], argv[2]
     result = {"ok": False, "message": ""}
@@ -133,6 +143,8 @@ def main(argv):
                 result.update(solve(sn, inputs))
             elif mode == "error":
                 result.update(compute_error(sn, inputs))
+            elif mode == "read":
+                result.update(read_file(sn, inputs))
             else:
                 raise ValueError(f"unknown mode {mode!r}")
         result["ok"] = True

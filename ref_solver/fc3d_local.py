@@ -10,8 +10,9 @@ Strategy of :func:`solve_local` (kinds ``AC`` and ``FB``):
 2. stick: if r = -Wl^-1 ql lies in K, it is a solution (u = 0);
 3. slide: damped semismooth Newton on the Alart–Curnier function (or on the Fischer–Burmeister
    function of the second-order cone complementarity problem), Armijo line search on
-   0.5 |Phi|^2, started from the warm start; if it fails, projected fixed-point iterations then
-   Newton again. The best iterate (smallest natural-map residual) is kept.
+   0.5 |Phi|^2, started from the warm start; if it fails, Newton from a sliding guess, then
+   projected fixed-point iterations and Newton again, then Newton on the other function (FB
+   for AC, AC for FB). The best iterate (smallest natural-map residual) is kept.
 
 Kind ``PROJECTION`` does one projection step r <- P_K(r - rho (u + [mu |u_T|, 0, 0])),
 rho = 1 / Wl_NN, and nothing else (the "one projection per contact" variant of Siconos).
@@ -396,7 +397,23 @@ def solve_local(
     if residual <= tolerance:
         return LOCAL_OK
     best_residual = _keep_best(r, residual, best, np.inf)
-    # 4. fall-back: projected fixed-point iterations with a small step, then Newton again
+    # 4. second start: sliding against the tangential velocity that the normal impulse alone
+    #    would leave, r = r_N (1, -mu e), r_N = -ql_N / W_NN
+    if w_nn > 0.0:
+        r[0] = -ql[0] / w_nn
+        t1 = ql[1] + Wl[1, 0] * r[0]
+        t2 = ql[2] + Wl[2, 0] * r[0]
+        norm_t = math.hypot(t1, t2)
+        r[1] = -mu * r[0] * t1 / norm_t if norm_t > 0.0 else 0.0
+        r[2] = -mu * r[0] * t2 / norm_t if norm_t > 0.0 else 0.0
+        residual = _newton(kind, Wl, ql, mu, rho_n, rho_t, r, tolerance, max_iterations, vec,
+                           mat)
+        best_residual = _keep_best(r, residual, best, best_residual)
+        if best_residual <= tolerance:
+            for i in range(3):
+                r[i] = best[i]
+            return LOCAL_OK
+    # 5. fall-back: projected fixed-point iterations with a small step, then Newton again
     norm_w = 0.0
     for i in range(3):
         for j in range(3):
@@ -408,8 +425,12 @@ def solve_local(
     best_residual = _keep_best(r, local_residual(r, u, ql, mu), best, best_residual)
     residual = _newton(kind, Wl, ql, mu, rho_n, rho_t, r, tolerance, max_iterations, vec, mat)
     best_residual = _keep_best(r, residual, best, best_residual)
-    if kind == FB and best_residual > tolerance:  # FB stuck: the AC function may do better
-        residual = _newton(AC, Wl, ql, mu, rho_n, rho_t, r, tolerance, max_iterations, vec, mat)
+    if best_residual > tolerance:  # still stuck: the other local function, from the best point
+        for i in range(3):
+            r[i] = best[i]
+        other = AC if kind == FB else FB
+        residual = _newton(other, Wl, ql, mu, rho_n, rho_t, r, tolerance, max_iterations, vec,
+                           mat)
         best_residual = _keep_best(r, residual, best, best_residual)
     for i in range(3):
         r[i] = best[i]
