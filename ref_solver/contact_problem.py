@@ -19,6 +19,7 @@ The solvers live in :mod:`fc3d_nsgs` and :mod:`fc3d_newton`; the dispatcher
 from __future__ import annotations
 
 import enum
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -120,15 +121,21 @@ class ContactProblem:
         """Number of frictional contacts nc."""
         return self.mu.size
 
+    @functools.cached_property
+    def _csr(self) -> sp.csr_matrix:
+        return self.W if sp.issparse(self.W) else sp.csr_matrix(self.W)
+
+    @functools.cached_property
+    def _dense(self) -> np.ndarray:
+        return self.W.toarray() if sp.issparse(self.W) else self.W
+
     def W_csr(self) -> sp.csr_matrix:
-        """W as CSR (explicit zeros of a dense W dropped)."""
-        if sp.issparse(self.W):
-            return self.W
-        return sp.csr_matrix(self.W)
+        """W as CSR (explicit zeros of a dense W dropped); computed once. Do not modify."""
+        return self._csr
 
     def W_dense(self) -> np.ndarray:
-        """W as a dense ndarray."""
-        return self.W.toarray() if sp.issparse(self.W) else self.W
+        """W as a dense ndarray; computed once. Do not modify."""
+        return self._dense
 
     def velocity(self, r: np.ndarray) -> np.ndarray:
         """u = W r + q, shape (m,)."""
