@@ -10,7 +10,9 @@ Strategy of :func:`solve_local` (kinds ``AC`` and ``FB``):
 2. stick: if r = -Wl^-1 ql lies in K, it is a solution (u = 0);
 3. slide: damped semismooth Newton on the Alart–Curnier function (or on the Fischer–Burmeister
    function of the second-order cone complementarity problem), Armijo line search on
-   0.5 |Phi|^2, started from the warm start; if it fails, Newton from a sliding guess, then
+   0.5 |Phi|^2, started from the warm start (FB: if it fails, AC Newton from where FB stopped,
+   since FB loses its fast convergence at degenerate contacts); if it fails, Newton from a
+   sliding guess, then
    projected fixed-point iterations and Newton again, then Newton on the other function (FB
    for AC, AC for FB). The best iterate (smallest natural-map residual) is kept.
 
@@ -297,9 +299,10 @@ def _newton(
     phi_try = vec[_PHITRY]
     merit = _merit_and_jacobian(kind, Wl, ql, mu, rho_n, rho_t, r, u, phi, mat, vec, True)
     residual = local_residual(r, u, ql, mu)
+    slow_steps = 0
     for _ in range(max_iterations):
-        if residual <= tolerance:
-            break
+        if residual <= tolerance or slow_steps >= 3:  # converged, or stagnating: let the
+            break  # caller's fall-backs take over rather than crawl
         for i in range(3):
             vec[_TMP3, i] = -phi[i]
         if not solve3(mat[_J], vec[_TMP3], d, mat[_LU]):
@@ -321,7 +324,9 @@ def _newton(
         for i in range(3):
             r[i] = r_try[i]
         merit = _merit_and_jacobian(kind, Wl, ql, mu, rho_n, rho_t, r, u, phi, mat, vec, True)
+        previous = residual
         residual = local_residual(r, u, ql, mu)
+        slow_steps = slow_steps + 1 if residual > 0.5 * previous else 0
     return residual
 
 
@@ -397,6 +402,13 @@ def solve_local(
     if residual <= tolerance:
         return LOCAL_OK
     best_residual = _keep_best(r, residual, best, np.inf)
+    if kind == FB:  # FB loses its fast convergence at degenerate contacts: AC from there
+        residual = _newton(AC, Wl, ql, mu, rho_n, rho_t, r, tolerance, max_iterations, vec, mat)
+        best_residual = _keep_best(r, residual, best, best_residual)
+        if best_residual <= tolerance:
+            for i in range(3):
+                r[i] = best[i]
+            return LOCAL_OK
     # 4. second start: sliding against the tangential velocity that the normal impulse alone
     #    would leave, r = r_N (1, -mu e), r_N = -ql_N / W_NN
     if w_nn > 0.0:
