@@ -21,8 +21,20 @@ demo: $(STAMP)
 lint: $(STAMP)
 	$(PY) -m ruff check .
 
-test: $(STAMP) lint
+test: $(STAMP) lint siconos
 	$(PY) -m pytest -m "not slow"
+
+# Debian's python3-siconos (Siconos 4.4) for the side-by-side validation; never fails the build.
+siconos:
+	@if env -i PATH=/usr/bin:/bin /usr/bin/python3 -c "import siconos.numerics" >/dev/null 2>&1; then \
+		echo "siconos: python3-siconos is installed"; \
+	elif [ "$$(id -u)" = "0" ] && command -v apt-get >/dev/null 2>&1; then \
+		echo "siconos: installing python3-siconos with apt-get"; \
+		( apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq python3-siconos >/dev/null ) \
+			|| echo "siconos: WARNING: apt-get could not install python3-siconos; Siconos comparisons will be skipped"; \
+	else \
+		echo "siconos: python3-siconos not installed (needs root and apt-get); Siconos comparisons will be skipped"; \
+	fi
 
 clean:
 	rm -rf $(VENV) build *.egg-info

@@ -1,0 +1,123 @@
+"""Run a Siconos worker script under Debian's Python, isolated, with a time limit.
+
+Siconos 4.4 (Debian ``python3-siconos``) imports only under /usr/bin/python3 with Debian's numpy
+and an environment free of PYTHONPATH / virtual-environment variables, so every Siconos call
+goes through a worker process. Inputs and outputs are .npz files; the worker's stdout is
+ignored (Siconos prints noise there). A crash, a hang or a missing Siconos becomes a status.
+"""
+
+from __future__ import annotations
+
+import enum
+import functools
+import os
+import subprocess
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+#: Interpreter that has Debian's python3-siconos.
+SICONOS_PYTHON = "/usr/bin/python3"
+
+#: Environment variables passed to the worker (everything else is dropped).
+_KEPT_VARIABLES = ("HOME", "LANG", "LC_ALL", "TMPDIR")
+
+
+class WorkerStatus(enum.Enum):
+    """How a worker run ended."""
+
+    OK = "ok"
+    FAILED = "failed"  # the worker reported an exception
+    CRASHED = "crashed"  # killed by a signal or exited without an output file
+    TIMED_OUT = "timed_out"
+    UNAVAILABLE = "unavailable"  # Siconos cannot be imported here
+
+
+@dataclass(frozen=True)
+class WorkerOutcome:
+    """Result of :func:`run_worker`: status, the output arrays, wall time of the process (s)."""
+
+    status: WorkerStatus
+    outputs: dict = field(default_factory=dict)
+    process_time: float = 0.0
+    returncode: int | None = None
+    message: str = ""
+
+
+def clean_environment() -> dict[str, str]:
+    """A minimal environment for Debian's Python (no PYTHONPATH, no venv, no pyenv)."""
+    env = {"PATH": "/usr/bin:/bin"}
+    for name in _KEPT_VARIABLES:
+        if name in os.environ:
+            env[name] = os.environ[name]
+    env.setdefault("HOME", tempfile.gettempdir())
+    env["OMP_NUM_THREADS"] = "1"
+    return env
+
+
+@functools.cache
+def siconos_availability() -> tuple[bool, str]:
+    """(available, message): whether ``import siconos.numerics`` works under SICONOS_PYTHON."""
+    if not Path(SICONOS_PYTHON).exists():
+        return False, f"Siconos unavailable: {SICONOS_PYTHON} not found"
+    try:
+        completed = subprocess.run(
+            [SICONOS_PYTHON, "-c", "import siconos.numerics"], env=clean_environment(),
+            capture_output=True, text=True, timeout=120,
+        )
+    except (OSError, subprocess.TimeoutExpired) as error:
+        return False, f"Siconos unavailable: {error}"
+    if completed.returncode != 0:
+        last = (completed.stderr.strip().splitlines() or ["import failed"])[-1]
+        return False, (f"Siconos unavailable ({last}); install Debian's python3-siconos "
+                       "(`make siconos` as root)")
+    return True, "Siconos available"
+
+
+def siconos_available() -> bool:
+    """True if Debian's python3-siconos can be imported by :data:`SICONOS_PYTHON`."""
+    return siconos_availability()[0]
+
+
+def run_worker(script: str | Path, inputs: dict, timeout: float = 600.0) -> WorkerOutcome:
+    """Run ``SICONOS_PYTHON script INPUT.npz OUTPUT.npz`` with a clean environment.
+
+    Parameters
+    ----------
+    script : path of the worker script (it must not import clearbench).
+    inputs : dict of arrays / scalars / strings saved to INPUT.npz.
+    timeout : wall-clock limit of the process, seconds.
+    """
+    available, message = siconos_availability()
+    if not available:
+        return WorkerOutcome(WorkerStatus.UNAVAILABLE, message=message)
+    with tempfile.TemporaryDirectory(prefix="clearbench-siconos-") as folder:
+        input_path = Path(folder) / "input.npz"
+        output_path = Path(folder) / "output.npz"
+        np.savez(input_path, **inputs)
+        start = time.perf_counter()
+        try:
+            completed = subprocess.run(
+                [SICONOS_PYTHON, str(script), str(input_path), str(output_path)],
+                env=clean_environment(), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                text=True, timeout=timeout, cwd=folder,
+            )
+        except subprocess.TimeoutExpired:
+            return WorkerOutcome(WorkerStatus.TIMED_OUT, process_time=time.perf_counter() - start,
+                                 message=f"no answer within {timeout:g} s")
+        elapsed = time.perf_counter() - start
+        stderr_tail = "\n".join(completed.stderr.strip().splitlines()[-5:])
+        if not output_path.exists():
+            return WorkerOutcome(WorkerStatus.CRASHED, process_time=elapsed,
+                                 returncode=completed.returncode,
+                                 message=f"exit status {completed.returncode}: {stderr_tail}")
+        with np.load(output_path, allow_pickle=False) as data:
+            outputs = {key: data[key] for key in data.files}
+    ok = bool(outputs.get("ok", False))
+    return WorkerOutcome(
+        WorkerStatus.OK if ok else WorkerStatus.FAILED, outputs=outputs, process_time=elapsed,
+        returncode=completed.returncode, message=str(outputs.get("message", "")),
+    )

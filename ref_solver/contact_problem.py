@@ -1,0 +1,241 @@
+"""Data types of the one-step frictional contact problem: problem, options, result, status.
+
+The problem (one time step of the Moreau–Jean scheme, at impulse level) is the discrete 3D
+Coulomb frictional contact problem of FCLIB/Siconos, extended with bilateral (equality) rows:
+
+    u = W r + q,
+    u_b = 0                                  for the n_bilateral first rows (r_b free),
+    K_i* ∋ u_i + [mu_i |u_Ti|, 0, 0]  ⊥  r_i ∈ K_i = {|r_T| <= mu_i r_N}   for each contact i,
+
+with each contact a block of 3 rows ordered (N, T1, T2). The unknown r is an impulse and u a
+relative velocity, in whatever consistent units the caller uses: W is in (velocity / impulse),
+q in velocity units. Every tolerance here is relative, so the problem may be given in any units.
+
+The solvers live in :mod:`fc3d_nsgs` and :mod:`fc3d_newton`; the dispatcher
+:func:`clearbench.ref_solver.fc3d_solve.solve_contact_problem` picks one from
+:class:`SolverOptions`.
+"""
+
+from __future__ import annotations
+
+import enum
+import functools
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+
+class SolverStatus(enum.Enum):
+    """How a solve ended. Only ``CONVERGED`` means the tolerance was met."""
+
+    CONVERGED = "converged"
+    MAX_ITERATIONS = "max_iterations"  # iteration cap reached before the tolerance
+    STALLED = "stalled"  # Newton: no descent step could be found (line search failed)
+    NUMERICAL_FAILURE = "numerical_failure"  # NaN/inf appeared, or a singular system
+
+
+class Normalisation(enum.Enum):
+    """Normalisation of the natural-map residual |F(r)| (2-norm over all rows).
+
+    ``Q``: |F| / |q| (Acary, Brémond & Huber 2018 comparison paper).
+    ``MAX``: |F| / max(|q|, |r|, |u|) (Siconos's ``fc3d_compute_error`` since 4.x).
+    If the denominator is zero (q = 0 and r = u = 0, or q = 0 for ``Q``), |F| is returned as is:
+    with q = 0 the solution is r = 0, F = 0, so this only matters for a non-solution.
+    """
+
+    Q = "q"
+    MAX = "max"
+
+
+METHODS = ("nsgs", "newton")
+LOCAL_SOLVERS = ("ac", "fb", "projection")
+
+
+def _as_matrix(W) -> np.ndarray | sp.csr_matrix:
+    """Return W as a float64 C-contiguous ndarray or a float64 CSR matrix."""
+    if sp.issparse(W):
+        return sp.csr_matrix(W, dtype=np.float64)
+    return np.ascontiguousarray(W, dtype=np.float64)
+
+
+@dataclass(frozen=True, eq=False)
+class ContactProblem:
+    """One-step frictional contact problem with optional bilateral rows.
+
+    Parameters
+    ----------
+    W : ndarray or scipy.sparse matrix, shape (m, m)
+        Delassus operator (velocity per impulse). Need not be symmetric.
+    q : ndarray, shape (m,)
+        Free relative velocity (velocity units).
+    mu : ndarray, shape (nc,)
+        Friction coefficients (>= 0), one per contact.
+    n_bilateral : int
+        Number of leading equality rows (r free, u = 0).
+
+    ``m == n_bilateral + 3 * nc`` is checked. Arrays are converted to float64 copies.
+    """
+
+    W: np.ndarray | sp.csr_matrix
+    q: np.ndarray
+    mu: np.ndarray
+    n_bilateral: int = 0
+
+    def __post_init__(self) -> None:
+        W = _as_matrix(self.W)
+        q = np.array(self.q, dtype=np.float64).ravel()
+        mu = np.array(self.mu, dtype=np.float64).ravel()
+        n_bilateral = int(self.n_bilateral)
+        if W.ndim != 2 or W.shape[0] != W.shape[1]:
+            raise ValueError(f"W must be square, got shape {W.shape}")
+        m = W.shape[0]
+        if q.shape != (m,):
+            raise ValueError(f"q must have shape ({m},), got {q.shape}")
+        if n_bilateral < 0 or n_bilateral > m:
+            raise ValueError(f"n_bilateral must be in [0, {m}], got {n_bilateral}")
+        if 3 * mu.size + n_bilateral != m:
+            raise ValueError(
+                f"size mismatch: m = {m} but n_bilateral + 3 * len(mu) = "
+                f"{n_bilateral} + 3 * {mu.size}"
+            )
+        if np.any(~np.isfinite(mu)) or np.any(mu < 0.0):
+            raise ValueError("mu must be finite and >= 0")
+        if not np.all(np.isfinite(q)):
+            raise ValueError("q contains NaN or inf")
+        values = W.data if sp.issparse(W) else W
+        if not np.all(np.isfinite(values)):
+            raise ValueError("W contains NaN or inf")
+        object.__setattr__(self, "W", W)
+        object.__setattr__(self, "q", q)
+        object.__setattr__(self, "mu", mu)
+        object.__setattr__(self, "n_bilateral", n_bilateral)
+
+    @property
+    def size(self) -> int:
+        """Number of rows m."""
+        return self.q.size
+
+    @property
+    def n_contacts(self) -> int:
+        """Number of frictional contacts nc."""
+        return self.mu.size
+
+    @functools.cached_property
+    def _csr(self) -> sp.csr_matrix:
+        return self.W if sp.issparse(self.W) else sp.csr_matrix(self.W)
+
+    @functools.cached_property
+    def _dense(self) -> np.ndarray:
+        return self.W.toarray() if sp.issparse(self.W) else self.W
+
+    def W_csr(self) -> sp.csr_matrix:
+        """W as CSR (explicit zeros of a dense W dropped); computed once. Do not modify."""
+        return self._csr
+
+    def W_dense(self) -> np.ndarray:
+        """W as a dense ndarray; computed once. Do not modify."""
+        return self._dense
+
+    def velocity(self, r: np.ndarray) -> np.ndarray:
+        """u = W r + q, shape (m,)."""
+        return self.W @ r + self.q
+
+
+@dataclass(frozen=True)
+class SolverOptions:
+    """Options of :func:`solve_contact_problem`.
+
+    Parameters
+    ----------
+    method : {"nsgs", "newton"}
+        Nonsmooth Gauss–Seidel over contacts, or semismooth Newton (Alart–Curnier) on all rows.
+    tolerance : float
+        Stop when the natural-map residual, normalised by ``normalisation``, is <= tolerance.
+    normalisation : {"max", "q"}
+        ``"max"`` (default): |F| / max(|q|, |r|, |u|), Siconos's measure; it stays meaningful
+        when |q| is tiny against |r| (resting contacts whose impulses only balance gravity) and
+        is what Siconos's own stopping test uses, so timings compare like with like.
+        ``"q"``: |F| / |q|, the measure of the 2018 FCLIB comparison paper (stricter when
+        |r| or |u| >> |q|).
+    max_iterations : int
+        Cap on sweeps (NSGS) or Newton iterations. Reaching it returns converged=False.
+    local_solver : {"ac", "fb", "projection"}
+        NSGS only. "ac": exact local solve by a damped Newton on the Alart–Curnier function,
+        with a projection fixed-point fall-back; "fb": the same with the Fischer–Burmeister
+        function; "projection": a single projection step per contact (no local iteration).
+    local_tolerance : float
+        Relative tolerance of the local solves (on |F_local| / max(|q_loc|, |r_i|, |u_i|)).
+    local_max_iterations : int
+        Cap on local Newton iterations per contact and sweep.
+    residual_check_interval : int
+        NSGS: the full residual (one product W r) is evaluated every this many sweeps and on
+        the last one.
+    """
+
+    method: str = "nsgs"
+    tolerance: float = 1e-10
+    normalisation: str = "max"
+    max_iterations: int = 10_000
+    local_solver: str = "ac"
+    local_tolerance: float = 1e-14
+    local_max_iterations: int = 30
+    residual_check_interval: int = 1
+
+    def __post_init__(self) -> None:
+        if self.method not in METHODS:
+            raise ValueError(f"method must be one of {METHODS}, got {self.method!r}")
+        if self.local_solver not in LOCAL_SOLVERS:
+            raise ValueError(
+                f"local_solver must be one of {LOCAL_SOLVERS}, got {self.local_solver!r}"
+            )
+        Normalisation(self.normalisation)
+        if not self.tolerance > 0.0:
+            raise ValueError(f"tolerance must be > 0, got {self.tolerance}")
+        if self.max_iterations < 1:
+            raise ValueError(f"max_iterations must be >= 1, got {self.max_iterations}")
+        if self.local_max_iterations < 1 or self.residual_check_interval < 1:
+            raise ValueError("local_max_iterations and residual_check_interval must be >= 1")
+
+
+@dataclass(frozen=True, eq=False)
+class SolverResult:
+    """Outcome of a contact solve.
+
+    Attributes
+    ----------
+    r : ndarray, shape (m,)
+        Impulses (bilateral rows first, then (N, T1, T2) per contact).
+    u : ndarray, shape (m,)
+        Relative velocities u = W r + q.
+    iterations : int
+        Sweeps (NSGS) or Newton iterations done.
+    residual : float
+        Natural-map residual in the normalisation of the options (the one tested).
+    residual_q, residual_max : float
+        The same residual in both normalisations (|F|/|q| and |F|/max(|q|,|r|,|u|)).
+    converged : bool
+        residual <= tolerance.
+    status : SolverStatus
+    method : str
+        Solver used, e.g. "nsgs-ac", "newton-ac".
+    message : str
+        Human-readable detail on a failure.
+    local_failures : int
+        NSGS: local solves that ended above the local tolerance (last sweep).
+    history : ndarray
+        Normalised residual at each check (NSGS) or Newton iteration.
+    """
+
+    r: np.ndarray
+    u: np.ndarray
+    iterations: int
+    residual: float
+    residual_q: float
+    residual_max: float
+    converged: bool
+    status: SolverStatus
+    method: str
+    message: str = ""
+    local_failures: int = 0
+    history: np.ndarray = field(default_factory=lambda: np.zeros(0))

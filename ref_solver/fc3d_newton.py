@@ -1,0 +1,239 @@
+"""Semismooth Newton method on the Alart–Curnier formulation of the whole problem.
+
+Unknown r (m,). Equation Phi(r) = 0 with, per contact, the Alart–Curnier function of
+:func:`fc3d_local.alart_curnier` (rho_N = 1 / W_ii[N, N], rho_T = 1 / max(W_ii[T1, T1],
+W_ii[T2, T2])) and, per bilateral row b, Phi_b = u_b / W_bb (so that all rows have impulse
+units). A generalised Jacobian is J = A + B W with A, B block diagonal; each iteration solves
+J d = -Phi by LU (dense up to 100 rows, sparse above) and takes an Armijo step on 0.5 |Phi|^2.
+
+When no descent step exists (a kink of Phi, or a singular J), a few NSGS sweeps are run from the
+current iterate and Newton resumes (the hybrid strategy Siconos also uses); the run stops as
+STALLED after too many such rescues without progress. Convergence is measured by the
+natural-map residual, as for NSGS.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from numba import njit
+
+from .contact_problem import (
+    ContactProblem,
+    Normalisation,
+    SolverOptions,
+    SolverResult,
+    SolverStatus,
+)
+from .fc3d_local import LOCAL_KIND, alart_curnier
+from .fc3d_nsgs import bilateral_solve_operator, diagonal_blocks, nsgs_kernel
+from .fc3d_residual import residual_both
+
+logger = logging.getLogger(__name__)
+
+_ARMIJO = 1e-4
+_MAX_HALVINGS = 30
+_RESCUE_SWEEPS = 10
+_MAX_RESCUES = 50
+_DELTA_MIN = 1e-12
+_DENSE_LIMIT = 100  # rows; below, dense LU beats scipy.sparse overhead
+_DELTA_MAX = 1e-3
+
+
+@njit(cache=True)
+def alart_curnier_system(
+    r: np.ndarray, u: np.ndarray, mu: np.ndarray, n_bilateral: int, rho_n: np.ndarray,
+    rho_t: np.ndarray, rho_b: np.ndarray, phi: np.ndarray, A: np.ndarray, B: np.ndarray,
+    want_jacobian: bool,
+) -> float:
+    """Phi (m,) and the contact blocks A, B (nc, 3, 3) of its Jacobian; returns 0.5 |Phi|^2."""
+    merit = 0.0
+    for b in range(n_bilateral):
+        phi[b] = rho_b[b] * u[b]
+        merit += phi[b] * phi[b]
+    for i in range(mu.size):
+        k = n_bilateral + 3 * i
+        alart_curnier(r[k:k + 3], u[k:k + 3], mu[i], rho_n[i], rho_t[i], phi[k:k + 3], A[i],
+                      B[i], want_jacobian)
+        merit += phi[k] ** 2 + phi[k + 1] ** 2 + phi[k + 2] ** 2
+    return 0.5 * merit
+
+
+@njit(cache=True)
+def dense_jacobian(W: np.ndarray, n_bilateral: int, rho_b: np.ndarray, A: np.ndarray,
+                   B: np.ndarray, delta: float, J: np.ndarray) -> None:
+    """J = A + B W + delta I as a dense (m, m) array (A, B block diagonal, W dense)."""
+    m = W.shape[0]
+    for b in range(n_bilateral):
+        for col in range(m):
+            J[b, col] = rho_b[b] * W[b, col]
+        J[b, b] += delta
+    for i in range(A.shape[0]):
+        k = n_bilateral + 3 * i
+        for a in range(3):
+            for col in range(m):
+                J[k + a, col] = B[i, a, 0] * W[k, col] + B[i, a, 1] * W[k + 1, col] \
+                    + B[i, a, 2] * W[k + 2, col]
+            for c in range(3):
+                J[k + a, k + c] += A[i, a, c]
+            J[k + a, k + a] += delta
+
+
+def _block_diagonal(n_bilateral: int, bilateral_diagonal: np.ndarray, blocks: np.ndarray):
+    """Sparse (m, m) matrix diag(bilateral_diagonal) ⊕ blocks[0] ⊕ ... ⊕ blocks[nc - 1]."""
+    nc = blocks.shape[0]
+    contact_part = sp.bsr_matrix(
+        (blocks, np.arange(nc), np.arange(nc + 1)), shape=(3 * nc, 3 * nc)
+    )
+    if n_bilateral == 0:
+        return contact_part.tocsc()
+    return sp.block_diag([sp.diags(bilateral_diagonal), contact_part], format="csc")
+
+
+def _regularised_direction_dense(W_dense, nb, rho_b, A, B, phi, residual, J):
+    """Dense counterpart of :func:`_regularised_direction` (small problems)."""
+    delta = min(_DELTA_MAX, max(_DELTA_MIN, residual))
+    for _ in range(6):
+        dense_jacobian(W_dense, nb, rho_b, A, B, delta, J)
+        try:
+            d = np.linalg.solve(J, -phi)
+            if np.all(np.isfinite(d)):
+                return d
+        except np.linalg.LinAlgError:
+            pass
+        delta *= 100.0
+    return None
+
+
+def _regularised_direction(J, phi: np.ndarray, residual: float) -> np.ndarray | None:
+    """Solve (J + delta I) d = -Phi; None if no finite solution.
+
+    W (hence J) is singular on redundant contact sets (four contacts under a box face give 12
+    rows for 6 degrees of freedom). The proximal term delta I (J is dimensionless) picks a
+    bounded direction; delta shrinks with the residual (Levenberg–Marquardt style, which keeps
+    fast local convergence) and grows when the factorisation fails.
+    """
+    identity = sp.identity(J.shape[0], format="csc")
+    delta = min(_DELTA_MAX, max(_DELTA_MIN, residual))
+    for _ in range(6):
+        try:
+            with np.errstate(all="ignore"):
+                d = spla.splu((J + delta * identity).tocsc()).solve(-phi)
+            if np.all(np.isfinite(d)):
+                return d
+        except RuntimeError:  # exactly singular
+            pass
+        delta *= 100.0
+    return None
+
+
+def solve_newton(
+    problem: ContactProblem, options: SolverOptions, r0: np.ndarray | None = None
+) -> SolverResult:
+    """Semismooth Newton solve of ``problem``; see ``solve_contact_problem``."""
+    W = problem.W_csr()
+    q, mu, nb, nc, m = problem.q, problem.mu, problem.n_bilateral, problem.n_contacts, problem.size
+    use_max = Normalisation(options.normalisation) is Normalisation.MAX
+    blocks = diagonal_blocks(W, nb, nc)
+    w_nn = blocks[:, 0, 0]
+    w_tt = np.maximum(blocks[:, 1, 1], blocks[:, 2, 2])
+    rho_n = np.where(w_nn > 0.0, 1.0 / np.where(w_nn > 0.0, w_nn, 1.0), 1.0)
+    rho_t = np.where(w_tt > 0.0, 1.0 / np.where(w_tt > 0.0, w_tt, 1.0), rho_n)
+    w_bb = W.diagonal()[:nb]
+    rho_b = np.where(w_bb > 0.0, 1.0 / np.where(w_bb > 0.0, w_bb, 1.0), 1.0)
+    r = np.zeros(m) if r0 is None else np.array(r0, dtype=np.float64, copy=True)
+    if r.shape != (m,):
+        raise ValueError(f"r0 must have shape ({m},), got {r.shape}")
+    phi = np.zeros(m)
+    A = np.zeros((nc, 3, 3))
+    B = np.zeros((nc, 3, 3))
+    phi_try = np.zeros(m)
+    A_try = np.zeros((nc, 3, 3))
+    B_try = np.zeros((nc, 3, 3))
+    bilateral_operator = None
+    W_dense = problem.W_dense() if m <= _DENSE_LIMIT else None
+    J_dense = np.empty((m, m)) if W_dense is not None else None
+    history: list[float] = []
+    rescues = 0
+    best_residual = np.inf
+    status = SolverStatus.MAX_ITERATIONS
+    message = ""
+    iteration = 0
+    residual = np.inf
+
+    def measure(r_: np.ndarray) -> tuple[np.ndarray, float]:
+        u_ = W @ r_ + q
+        _, rel_q, rel_max = residual_both(r_, u_, q, mu, nb)
+        return u_, (rel_max if use_max else rel_q)
+
+    u, residual = measure(r)
+    while True:
+        if residual <= options.tolerance:
+            status = SolverStatus.CONVERGED
+            break
+        if not math.isfinite(residual):
+            status = SolverStatus.NUMERICAL_FAILURE
+            message = "non-finite residual"
+            break
+        if iteration >= options.max_iterations:
+            status = SolverStatus.MAX_ITERATIONS
+            break
+        iteration += 1
+        merit = alart_curnier_system(r, u, mu, nb, rho_n, rho_t, rho_b, phi, A, B, True)
+        if W_dense is not None:
+            d = _regularised_direction_dense(W_dense, nb, rho_b, A, B, phi, residual, J_dense)
+        else:
+            J = (_block_diagonal(nb, np.zeros(nb), A)
+                 + _block_diagonal(nb, rho_b, B) @ W).tocsc()
+            d = _regularised_direction(J, phi, residual)
+        step_ok = d is not None
+        if step_ok:
+            step = 1.0
+            step_ok = False
+            for _ in range(_MAX_HALVINGS):
+                r_try = r + step * d
+                u_try = W @ r_try + q
+                merit_try = alart_curnier_system(r_try, u_try, mu, nb, rho_n, rho_t, rho_b,
+                                                 phi_try, A_try, B_try, False)
+                if merit_try <= (1.0 - 2.0 * _ARMIJO * step) * merit:
+                    step_ok = True
+                    break
+                step *= 0.5
+        if step_ok:
+            r = r_try
+        else:
+            # rescue: a few NSGS sweeps from the current iterate
+            rescues += 1
+            if rescues > _MAX_RESCUES and residual >= best_residual:
+                status = SolverStatus.STALLED
+                message = f"no descent direction after {rescues} NSGS rescues"
+                break
+            if bilateral_operator is None:
+                bilateral_operator = bilateral_solve_operator(problem.W_dense()[:nb, :nb])
+            u_tmp = np.empty(m)
+            nsgs_kernel(W.indptr.astype(np.int64), W.indices.astype(np.int64), W.data, q, mu,
+                        nb, blocks, bilateral_operator, r, u_tmp, LOCAL_KIND["ac"],
+                        options.tolerance, use_max, _RESCUE_SWEEPS, options.local_tolerance,
+                        options.local_max_iterations, _RESCUE_SWEEPS,
+                        np.full(_RESCUE_SWEEPS, np.nan))
+        u, residual = measure(r)
+        best_residual = min(best_residual, residual)
+        history.append(residual)
+    if status is SolverStatus.MAX_ITERATIONS:
+        message = (f"{options.max_iterations} Newton iterations done, residual {residual:.3g}"
+                   f" > {options.tolerance:.3g}")
+    u = W @ r + q
+    _, residual_q, residual_max = residual_both(r, u, q, mu, nb)
+    if status is not SolverStatus.NUMERICAL_FAILURE:
+        residual = residual_max if use_max else residual_q
+    return SolverResult(
+        r=r, u=u, iterations=int(iteration), residual=float(residual),
+        residual_q=float(residual_q), residual_max=float(residual_max),
+        converged=status is SolverStatus.CONVERGED, status=status, method="newton-ac",
+        message=message + (f" ({rescues} NSGS rescues)" if rescues else ""),
+        history=np.array(history),
+    )

@@ -1,0 +1,187 @@
+"""Nonsmooth Gauss–Seidel (NSGS) over contacts, with an exact local solver per contact.
+
+One sweep: the bilateral rows are solved exactly for the current contact impulses
+(r_b = -W_bb^-1 (q_b + W_bc r_c), W_bb factorised once), then each contact in turn solves its
+3x3 problem u_i = W_ii r_i + (q_i + sum_{j != i} W_ij r_j) with the others frozen
+(:func:`fc3d_local.solve_local`). W is walked in CSR form, so a sweep costs O(nnz(W)) plus the
+local solves. The natural-map residual (one more pass over W) is evaluated every
+``residual_check_interval`` sweeps.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+
+import numpy as np
+import scipy.sparse as sp
+from numba import njit
+
+from .contact_problem import (
+    ContactProblem,
+    Normalisation,
+    SolverOptions,
+    SolverResult,
+    SolverStatus,
+)
+from .fc3d_local import LOCAL_FAILED, LOCAL_KIND, N_MAT, N_VEC, solve_local
+from .fc3d_residual import csr_matvec_plus, natural_map_squared, normalised
+
+logger = logging.getLogger(__name__)
+
+_STATUS_CODES = (
+    SolverStatus.CONVERGED,
+    SolverStatus.MAX_ITERATIONS,
+    SolverStatus.STALLED,
+    SolverStatus.NUMERICAL_FAILURE,
+)
+_NO_OPERATOR = np.zeros((0, 0))
+
+
+def diagonal_blocks(W_csr: sp.csr_matrix, n_bilateral: int, n_contacts: int) -> np.ndarray:
+    """The (nc, 3, 3) diagonal blocks W_ii of the contact rows."""
+    blocks = np.zeros((n_contacts, 3, 3))
+    _extract_blocks(W_csr.indptr, W_csr.indices, W_csr.data, n_bilateral, blocks)
+    return blocks
+
+
+@njit(cache=True)
+def _extract_blocks(indptr, indices, data, n_bilateral, blocks):
+    for i in range(blocks.shape[0]):
+        k = n_bilateral + 3 * i
+        for a in range(3):
+            row = k + a
+            for p in range(indptr[row], indptr[row + 1]):
+                col = indices[p]
+                if k <= col < k + 3:
+                    blocks[i, a, col - k] += data[p]
+
+
+def bilateral_solve_operator(W_dense_bb: np.ndarray) -> np.ndarray:
+    """Dense operator S with r_b = S rhs solving W_bb r_b = rhs (pseudo-inverse if singular).
+
+    Redundant bilateral rows (a singular W_bb) get the minimum-norm impulses.
+    """
+    if W_dense_bb.size == 0:
+        return np.zeros((0, 0))
+    condition = np.linalg.cond(W_dense_bb)
+    if np.isfinite(condition) and condition < 1e12:
+        return np.linalg.inv(W_dense_bb)
+    logger.info("bilateral block ill-conditioned (cond %.3g): using its pseudo-inverse", condition)
+    return np.linalg.pinv(W_dense_bb, rcond=1e-12)
+
+
+@njit(cache=True)
+def nsgs_kernel(
+    indptr: np.ndarray, indices: np.ndarray, data: np.ndarray, q: np.ndarray, mu: np.ndarray,
+    n_bilateral: int, blocks: np.ndarray, bilateral_operator: np.ndarray, r: np.ndarray,
+    u: np.ndarray, kind: int, tolerance: float, use_max: bool, max_sweeps: int,
+    local_tolerance: float, local_max_iterations: int, check_interval: int,
+    history: np.ndarray,
+) -> tuple[int, int, float, float, float, float, int, int]:
+    """Run NSGS sweeps on r (in place); u receives W r + q at the last residual check.
+
+    The last sweep is always checked. Returns (status code: 0 converged / 1 max iterations /
+    3 non-finite, sweeps done, |F|, |q|, |r|, |u|, local failures in the last sweep, number of
+    checks). ``history`` (>= max_sweeps,) receives the normalised residual of each check.
+    """
+    nc = mu.size
+    vec = np.zeros((N_VEC, 3))
+    mat = np.zeros((N_MAT, 3, 3))
+    ql = np.zeros(3)
+    ri = np.zeros(3)
+    rhs = np.zeros(n_bilateral)
+    norm_q = math.sqrt(np.dot(q, q))
+    abs_residual = np.inf
+    norm_r = 0.0
+    norm_u = 0.0
+    failures = 0
+    n_checks = 0
+    for sweep in range(max_sweeps):
+        # bilateral rows, exact: W_bb r_b = -(q_b + W_bc r_c)
+        if n_bilateral > 0:
+            for row in range(n_bilateral):
+                acc = q[row]
+                for p in range(indptr[row], indptr[row + 1]):
+                    col = indices[p]
+                    if col >= n_bilateral:
+                        acc += data[p] * r[col]
+                rhs[row] = -acc
+            for row in range(n_bilateral):
+                acc = 0.0
+                for col in range(n_bilateral):
+                    acc += bilateral_operator[row, col] * rhs[col]
+                r[row] = acc
+        failures = 0
+        for i in range(nc):
+            k = n_bilateral + 3 * i
+            for a in range(3):
+                row = k + a
+                acc = q[row]
+                for p in range(indptr[row], indptr[row + 1]):
+                    acc += data[p] * r[indices[p]]
+                ql[a] = acc - (blocks[i, a, 0] * r[k] + blocks[i, a, 1] * r[k + 1]
+                               + blocks[i, a, 2] * r[k + 2])
+                ri[a] = r[k + a]
+            code = solve_local(kind, blocks[i], ql, mu[i], ri, local_tolerance,
+                               local_max_iterations, vec, mat)
+            if code == LOCAL_FAILED:
+                failures += 1
+            r[k] = ri[0]
+            r[k + 1] = ri[1]
+            r[k + 2] = ri[2]
+        if (sweep + 1) % check_interval == 0 or sweep == max_sweeps - 1:
+            csr_matvec_plus(indptr, indices, data, r, q, u)
+            abs_residual = math.sqrt(natural_map_squared(r, u, mu, n_bilateral))
+            norm_r = math.sqrt(np.dot(r, r))
+            norm_u = math.sqrt(np.dot(u, u))
+            if not math.isfinite(abs_residual + norm_r + norm_u):
+                return 3, sweep + 1, np.nan, norm_q, norm_r, norm_u, failures, n_checks
+            residual = normalised(abs_residual, norm_q, norm_r, norm_u, use_max)
+            history[n_checks] = residual
+            n_checks += 1
+            if residual <= tolerance:
+                return 0, sweep + 1, abs_residual, norm_q, norm_r, norm_u, failures, n_checks
+    return 1, max_sweeps, abs_residual, norm_q, norm_r, norm_u, failures, n_checks
+
+
+def solve_nsgs(
+    problem: ContactProblem, options: SolverOptions, r0: np.ndarray | None = None
+) -> SolverResult:
+    """NSGS solve of ``problem``; see :func:`clearbench.ref_solver.solve_contact_problem`."""
+    W = problem.W_csr()
+    nb, nc = problem.n_bilateral, problem.n_contacts
+    blocks = diagonal_blocks(W, nb, nc)
+    operator = bilateral_solve_operator(problem.W_dense()[:nb, :nb]) if nb else _NO_OPERATOR
+    r = np.zeros(problem.size) if r0 is None else np.array(r0, dtype=np.float64, copy=True)
+    if r.shape != (problem.size,):
+        raise ValueError(f"r0 must have shape ({problem.size},), got {r.shape}")
+    if problem.size == 0:
+        return SolverResult(r=r, u=r.copy(), iterations=0, residual=0.0, residual_q=0.0,
+                            residual_max=0.0, converged=True, status=SolverStatus.CONVERGED,
+                            method=f"nsgs-{options.local_solver}")
+    u = np.empty(problem.size)
+    history = np.empty(options.max_iterations)  # untouched pages cost nothing
+    use_max = Normalisation(options.normalisation) is Normalisation.MAX
+    code, sweeps, abs_residual, norm_q, norm_r, norm_u, failures, n_checks = nsgs_kernel(
+        W.indptr, W.indices, W.data, problem.q, problem.mu, nb, blocks, operator, r, u,
+        LOCAL_KIND[options.local_solver], options.tolerance, use_max, options.max_iterations,
+        options.local_tolerance, options.local_max_iterations, options.residual_check_interval,
+        history,
+    )
+    status = _STATUS_CODES[code]
+    residual_q = normalised(abs_residual, norm_q, norm_r, norm_u, False)
+    residual_max = normalised(abs_residual, norm_q, norm_r, norm_u, True)
+    message = ""
+    if status is SolverStatus.MAX_ITERATIONS:
+        message = f"{sweeps} sweeps done, residual {history[n_checks - 1]:.3g} > " \
+                  f"{options.tolerance:.3g}"
+    elif status is SolverStatus.NUMERICAL_FAILURE:
+        message = f"non-finite residual after {sweeps} sweeps"
+    return SolverResult(
+        r=r, u=u, iterations=int(sweeps), residual=residual_max if use_max else residual_q,
+        residual_q=residual_q, residual_max=residual_max,
+        converged=status is SolverStatus.CONVERGED, status=status,
+        method=f"nsgs-{options.local_solver}", message=message, local_failures=int(failures),
+        history=history[:n_checks].copy(),
+    )
