@@ -2,8 +2,9 @@
 
 Presets (each a separate engine variant in results):
 
-- ``default``: theta = 1/2, combined projection on, NSGS with exact Alart–Curnier local solves,
-  tolerance 1e-12 (|F| / max(|q|, |r|, |u|)).
+- ``default``: theta = 1/2, combined projection on, NSGS with exact Alart–Curnier local solves
+  switching to the semismooth Newton solver when NSGS stalls (``hybrid``), tolerance 1e-12
+  (|F| / max(|q|, |r|, |u|)).
 - ``no-projection``: plain Moreau–Jean (Moreau's activation g + h/2 u_N <= 0).
 - ``newton``: as default with the semismooth Newton one-step solver.
 - ``implicit``: theta = 1 (more dissipative, unconditionally stable for stiff springs).
@@ -29,10 +30,11 @@ from .reference_build import build_system, feature_lengths, initial_state
 from .trajectory import RunStatus, Trajectory
 
 PRESETS: dict[str, dict] = {
-    "default": {"theta": 0.5, "projection": True, "method": "nsgs"},
-    "no-projection": {"theta": 0.5, "projection": False, "method": "nsgs"},
+    "default": {"theta": 0.5, "projection": True, "method": "hybrid"},
+    "no-projection": {"theta": 0.5, "projection": False, "method": "hybrid"},
+    "nsgs": {"theta": 0.5, "projection": True, "method": "nsgs"},
     "newton": {"theta": 0.5, "projection": True, "method": "newton"},
-    "implicit": {"theta": 1.0, "projection": True, "method": "nsgs"},
+    "implicit": {"theta": 1.0, "projection": True, "method": "hybrid"},
 }
 OPTION_NAMES = ("theta", "projection", "method", "tolerance", "max_iterations",
                 "position_tolerance")
@@ -83,7 +85,8 @@ class ReferenceEngine(Engine):
         lengths = feature_lengths(scene)
         smallest = min(lengths) if lengths else 1.0
         largest = max(lengths) if lengths else 1.0
-        solver = SolverOptions(method=options["method"],
+        method = options["method"]
+        solver = SolverOptions(method="nsgs" if method == "hybrid" else method,
                                tolerance=float(options.get("tolerance", 1e-12)),
                                max_iterations=int(options.get("max_iterations", 10_000)))
         return StepperSettings(
@@ -96,6 +99,7 @@ class ReferenceEngine(Engine):
             position_tolerance=float(options.get("position_tolerance", 1e-10 * smallest)),
             activation_margin=1e-10 * smallest,
             length_scale=largest,
+            method=method,
         )
 
     def _run(self, scene: Scene, settings: RunSettings) -> Trajectory:
@@ -142,7 +146,7 @@ class ReferenceEngine(Engine):
         trajectory.message = message
         trajectory.metadata = {
             "theta": config.theta, "projection": config.projection,
-            "solver": config.solver.method, "tolerance": config.solver.tolerance,
+            "solver": config.method, "tolerance": config.solver.tolerance,
             "position_tolerance": config.position_tolerance,
             "unconverged_steps": recorder.unconverged,
             "unconverged_projections": recorder.unconverged_projection,

@@ -11,8 +11,9 @@ One step of length h from state k (Section 2.4 of Akhadkar, Acary, Brogliato 201
 3. Position update x_{k+1} = x_k + h v_theta, p_{k+1} = p_k exp(h Omega_theta).
 4. Projection stage (``projection=True``): Newton iterations on the position constraints of
    joints, translational drivers and the contacts of I: a mixed LCP in the multipliers delta
-   with the mass-weighted correction dq = M^-1 H^T delta, until every violation is below
-   ``position_tolerance``.
+   with the correction dq = Mp^-1 H^T delta (Mp: mass for translations, inertia about the
+   body's constraint points for rotations, see ``_projection_metric_inverse``), until every
+   violation is below ``position_tolerance``.
 5. Activation stage: I <- I U {alpha : g_alpha(q_{k+1}) <= 0}; when I grew, the step is redone
    from state k (eq. 22). I starts as the contacts already closed at q_k (gap <= the activation
    margin); without projection it starts as Moreau's prediction g + (h/2) u_N <= 0.
@@ -24,7 +25,7 @@ flagged there, never hidden.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -42,7 +43,7 @@ from .contact_problem import ContactProblem, SolverOptions
 from .fc3d_solve import solve_contact_problem
 from .forces import applied_forces, rotation_matrices, spring_jacobians
 from .gyroscopic import gyroscopic_update
-from .mlcp import solve_mlcp
+from .projection import solve_projection
 from .system import MultibodySystem, State
 
 
@@ -69,6 +70,9 @@ class StepperSettings:
         of the step [L].
     length_scale : float
         Characteristic length [L] for finite-difference steps of the spring stiffness.
+    method : str
+        ``nsgs``, ``newton`` or ``hybrid`` (NSGS for at most ``hybrid_sweeps`` sweeps, then
+        Newton from where it stopped).
     """
 
     time_step: float
@@ -80,6 +84,8 @@ class StepperSettings:
     max_activation_rounds: int = 20
     activation_margin: float = 1e-12
     length_scale: float = 1.0
+    method: str = "hybrid"
+    hybrid_sweeps: int = 100
 
     def __post_init__(self) -> None:
         if not self.time_step > 0.0:
@@ -143,6 +149,7 @@ class MoreauJeanStepper:
             inverse[r, r] = system.inverse_inertia[b]
         self.mass_matrix = mass_matrix
         self.inverse_mass = inverse
+        self.projection_inverse = self._projection_metric_inverse(system)
         self._clusters(system)
         npair = system.pair_count
         k = MAX_CONTACTS_PER_PAIR
@@ -153,6 +160,35 @@ class MoreauJeanStepper:
                                 np.arange(0, 6 * nb + 1, 6, dtype=np.int64))
 
     # ------------------------------------------------------------------ set-up
+    @staticmethod
+    def _projection_metric_inverse(system: MultibodySystem) -> np.ndarray:
+        """Inverse of the metric of the position projection, (6 nb, 6 nb) block diagonal.
+
+        Translations weigh the mass m; rotations weigh J + m rho^2 I, the inertia about the
+        body's farthest constraint point (shape origins and joint anchors, at distance rho
+        from the centre of mass). With the plain mass matrix, a light body whose centre of
+        mass is far from its joints (a pendulum bob) is corrected by rotating it about its
+        centre of mass, which swings the joint tangentially by more than a tight clearance and
+        the Newton projection does not converge. Any symmetric positive definite metric
+        projects onto the same constraint manifold; this one is scale invariant.
+        """
+        nb = system.body_count
+        rho = np.zeros(nb)
+        for shape, body in enumerate(system.shape_body):
+            rho[body] = max(rho[body], float(np.linalg.norm(system.shape_position[shape])))
+        for j in range(system.joint_kind.shape[0]):
+            for body, anchor in ((system.joint_body_a[j], system.joint_anchor_a[j]),
+                                 (system.joint_body_b[j], system.joint_anchor_b[j])):
+                rho[body] = max(rho[body], float(np.linalg.norm(anchor)))
+        out = np.zeros((6 * nb, 6 * nb))
+        for b in range(nb):
+            if system.body_fixed[b]:
+                continue
+            out[6 * b:6 * b + 3, 6 * b:6 * b + 3] = np.eye(3) / system.mass[b]
+            angular = system.inertia[b] + system.mass[b] * rho[b] ** 2 * np.eye(3)
+            out[6 * b + 3:6 * b + 6, 6 * b + 3:6 * b + 6] = np.linalg.inv(angular)
+        return out
+
     def _clusters(self, system: MultibodySystem) -> None:
         """Bodies coupled by springs form clusters; the iteration matrix is block diagonal
         over clusters (each body alone when there is no spring)."""
@@ -251,6 +287,20 @@ class MoreauJeanStepper:
         return StepResult(new_state, stats, impulses, cand[3], cand[2], active)
 
     # ------------------------------------------------------------------ pieces
+    def _solve(self, problem: ContactProblem, r0: np.ndarray):
+        """One-step problem: NSGS, or Newton, or NSGS followed by Newton warm-started from
+        where NSGS stopped (``hybrid``): redundant contacts (the two rings of a bearing) make W
+        singular, where NSGS crawls and Newton converges in a few iterations."""
+        cfg = self.settings
+        if cfg.method != "hybrid":
+            return solve_contact_problem(problem, replace(cfg.solver, method=cfg.method), r0=r0)
+        first = solve_contact_problem(
+            problem, replace(cfg.solver, method="nsgs", max_iterations=cfg.hybrid_sweeps), r0=r0)
+        if first.converged:
+            return first
+        second = solve_contact_problem(problem, replace(cfg.solver, method="newton"), r0=first.r)
+        return replace(second, iterations=first.iterations + second.iterations)
+
     def _cluster_inverse(self, matrix: np.ndarray) -> np.ndarray:
         out = np.zeros_like(matrix)
         for c in range(len(self.cluster_start) - 1):
@@ -344,7 +394,7 @@ class MoreauJeanStepper:
             r0 = np.concatenate((self.previous_bilateral,
                                  self.previous_impulse[pairs, slots].ravel()))
             problem = ContactProblem(w, q, sys_.pair_friction[pairs], n_bilateral=nbil)
-            solve = solve_contact_problem(problem, cfg.solver, r0=r0)
+            solve = self._solve(problem, r0)
             new_nu = free + (y @ solve.r).reshape(-1, 6)
             self.previous_bilateral = solve.r[:nbil].copy()
             impulses[pairs, slots] = solve.r[nbil:].reshape(-1, 3)
@@ -396,12 +446,10 @@ class MoreauJeanStepper:
                 break
             rb = np.ascontiguousarray(row_body[rows])
             rc = np.ascontiguousarray(row_coef[rows])
-            w, y = delassus(rb, rc, len(rows), self.inverse_mass, *self.single_clusters)
-            # Contacts already separated enough need no correction; keep them in the MLCP (their
-            # multiplier is zero) so that the set stays the active set of the step.
-            mlcp = solve_mlcp(w, values, n_equal, tolerance=1e-14,
-                              max_iterations=1000)
-            delta = (y @ mlcp.z).reshape(-1, 6)
+            w, y = delassus(rb, rc, len(rows), self.projection_inverse, *self.single_clusters)
+            # Contacts of the active set that are open keep a zero multiplier.
+            solve = solve_projection(w, values, n_equal, 0.1 * cfg.position_tolerance)
+            delta = (y @ solve.delta).reshape(-1, 6)
             state.x += delta[:, :3]
             for b in range(sys_.body_count):
                 if not sys_.body_fixed[b]:
