@@ -10,7 +10,8 @@ Presets (each a separate engine variant in results):
 - ``implicit``: theta = 1 (more dissipative, unconditionally stable for stiff springs).
 
 Options (``RunSettings.options``) override: ``theta``, ``projection``, ``method``,
-``tolerance``, ``max_iterations``, ``position_tolerance``.
+``tolerance``, ``max_iterations``, ``position_tolerance``, ``restitution_threshold`` (default
+2 |g| h: slower impacts are plastic, see :class:`StepperSettings`).
 """
 
 from __future__ import annotations
@@ -37,7 +38,7 @@ PRESETS: dict[str, dict] = {
     "implicit": {"theta": 1.0, "projection": True, "method": "hybrid"},
 }
 OPTION_NAMES = ("theta", "projection", "method", "tolerance", "max_iterations",
-                "position_tolerance")
+                "position_tolerance", "restitution_threshold")
 
 
 def availability() -> tuple[bool, str]:
@@ -100,6 +101,12 @@ class ReferenceEngine(Engine):
             activation_margin=1e-10 * smallest,
             length_scale=largest,
             method=method,
+            # Bounces slower than two steps' worth of gravity cannot be resolved by the fixed
+            # step; they are taken as plastic so that bodies come to rest (see StepperSettings).
+            restitution_threshold=float(options.get(
+                "restitution_threshold",
+                2.0 * float(np.linalg.norm(scene.gravity)) * (settings.time_step
+                                                               or scene.time_step))),
         )
 
     def _run(self, scene: Scene, settings: RunSettings) -> Trajectory:

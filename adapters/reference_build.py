@@ -204,4 +204,11 @@ def feature_lengths(scene: Scene) -> list[float]:
     for contact in scene.all_contacts:
         if contact.offset > 0:
             lengths.append(contact.offset)
+    # Joint lever arms: distance from each body's centre of mass to its joint anchors.
+    x, _, _ = body_frames(scene)
+    for joint in scene.joints:
+        for name in (joint.body_a, joint.body_b):
+            if scene.body(name).motion is not Motion.FIXED:
+                lengths.append(float(np.linalg.norm(np.asarray(joint.anchor)
+                                                    - x[scene.body_index(name)])))
     return [length for length in lengths if length > 0 and math.isfinite(length)]

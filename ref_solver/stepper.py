@@ -73,6 +73,11 @@ class StepperSettings:
     method : str
         ``nsgs``, ``newton`` or ``hybrid`` (NSGS for at most ``hybrid_sweeps`` sweeps, then
         Newton from where it stopped).
+    restitution_threshold : float
+        Impacts with a normal approach speed below this [L/T] are plastic (e = 0). A bounce of
+        speed v under gravity g lasts 2 v / g; below about g h it fits within one step and a
+        fixed-step scheme cannot resolve it: with e > 0 a resting body would chatter at an
+        amplitude of order e^2 g h^2 instead of coming to rest. 0 disables the threshold.
     """
 
     time_step: float
@@ -86,6 +91,7 @@ class StepperSettings:
     length_scale: float = 1.0
     method: str = "hybrid"
     hybrid_sweeps: int = 100
+    restitution_threshold: float = 0.0
 
     def __post_init__(self) -> None:
         if not self.time_step > 0.0:
@@ -288,18 +294,34 @@ class MoreauJeanStepper:
 
     # ------------------------------------------------------------------ pieces
     def _solve(self, problem: ContactProblem, r0: np.ndarray):
-        """One-step problem: NSGS, or Newton, or NSGS followed by Newton warm-started from
-        where NSGS stopped (``hybrid``): redundant contacts (the two rings of a bearing) make W
-        singular, where NSGS crawls and Newton converges in a few iterations."""
+        """One-step problem: NSGS, Newton, or ``hybrid``.
+
+        ``hybrid``: NSGS for at most ``hybrid_sweeps`` sweeps from the warm start; when it has
+        not converged, semismooth Newton from where NSGS stopped, then from the warm start, then
+        from zero, then NSGS to its full cap from zero and from where it stopped, keeping the
+        first that converges (else the smallest residual). Redundant
+        contacts (the two rings of a bearing) make W singular: NSGS crawls there and Newton can
+        stall from a poor start, while another start converges in a few iterations.
+        """
         cfg = self.settings
         if cfg.method != "hybrid":
             return solve_contact_problem(problem, replace(cfg.solver, method=cfg.method), r0=r0)
-        first = solve_contact_problem(
+        best = solve_contact_problem(
             problem, replace(cfg.solver, method="nsgs", max_iterations=cfg.hybrid_sweeps), r0=r0)
-        if first.converged:
-            return first
-        second = solve_contact_problem(problem, replace(cfg.solver, method="newton"), r0=first.r)
-        return replace(second, iterations=first.iterations + second.iterations)
+        if best.converged:
+            return best
+        iterations = best.iterations
+        newton = replace(cfg.solver, method="newton", max_iterations=200)
+        nsgs = replace(cfg.solver, method="nsgs")
+        attempts = ((newton, best.r), (newton, r0), (newton, None), (nsgs, None), (nsgs, best.r))
+        for options, start in attempts:
+            attempt = solve_contact_problem(problem, options, r0=start)
+            iterations += attempt.iterations
+            if attempt.converged or attempt.residual < best.residual:
+                best = attempt
+            if attempt.converged:
+                break
+        return replace(best, iterations=iterations)
 
     def _cluster_inverse(self, matrix: np.ndarray) -> np.ndarray:
         out = np.zeros_like(matrix)
@@ -390,7 +412,9 @@ class MoreauJeanStepper:
             if len(pairs):
                 u_k = row_values(row_body, row_coef, nu, nbil, m)[0::3]
                 e = sys_.pair_restitution[pairs]
-                q[nbil:][0::3] += e * np.minimum(u_k, 0.0)
+                # Newton's law only for impacts faster than the threshold (see settings).
+                impacting = u_k < -cfg.restitution_threshold
+                q[nbil:][0::3] += np.where(impacting, e * u_k, 0.0)
             r0 = np.concatenate((self.previous_bilateral,
                                  self.previous_impulse[pairs, slots].ravel()))
             problem = ContactProblem(w, q, sys_.pair_friction[pairs], n_bilateral=nbil)
