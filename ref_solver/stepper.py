@@ -10,7 +10,7 @@ One step of length h from state k (Section 2.4 of Akhadkar, Acary, Brogliato 201
    complementarity problem (De Saxcé), solved by :func:`solve_contact_problem`.
 3. Position update x_{k+1} = x_k + h v_theta, p_{k+1} = p_k exp(h Omega_theta).
 4. Projection stage (``projection=True``): Newton iterations on the position constraints of
-   joints, translational drivers and the contacts of I: a mixed LCP in the multipliers delta
+   joints, drivers and the contacts of I: a mixed LCP in the multipliers delta
    with the correction dq = Mp^-1 H^T delta (Mp: mass for translations, inertia about the
    body's constraint points for rotations, see ``_projection_metric_inverse``), until every
    violation is below ``position_tolerance``.
@@ -375,7 +375,7 @@ class MoreauJeanStepper:
                            sys_.joint_relative_rotation, sys_.driver_body,
                            sys_.driver_component, sys_.driver_quantity, sys_.driver_start,
                            sys_.driver_times, sys_.driver_values, sys_.driver_initial,
-                           row_body, row_coef, violation, target)
+                           sys_.driver_reference, row_body, row_coef, violation, target)
         if len(pairs):
             contact_rows(x, rotation, sys_.body_fixed, sys_.shape_body, sys_.pair_shape_a,
                          sys_.pair_shape_b, pairs.astype(np.int64), slots.astype(np.int64),
@@ -441,7 +441,6 @@ class MoreauJeanStepper:
         sys_ = self.system
         cfg = self.settings
         nbil = sys_.bilateral_row_count
-        rotation_driver = sys_.driver_component >= 3
         worst = 0.0
         for iteration in range(cfg.max_projection_iterations + 1):
             rotation = rotation_matrices(state.p)
@@ -449,9 +448,6 @@ class MoreauJeanStepper:
             row_body, row_coef, violation, _, pairs, slots = self._rows(
                 state.t, state.x, state.p, rotation, cand, active)
             keep = np.ones(row_body.shape[0], dtype=bool)
-            if nbil:
-                joint_rows = nbil - len(sys_.driver_body)
-                keep[joint_rows:nbil] = ~rotation_driver
             # Contacts: only the normal rows take part in the projection.
             if len(pairs):
                 contact_part = np.zeros(3 * len(pairs), dtype=bool)
