@@ -157,7 +157,15 @@ class ReferenceEngine(Engine):
             "position_tolerance": config.position_tolerance,
             "unconverged_steps": recorder.unconverged,
             "unconverged_projections": recorder.unconverged_projection,
+            "solver_seconds": recorder.solver_seconds,
+            "contact_sweeps": recorder.contact_sweeps,
         }
+        if recorder.unconverged or recorder.unconverged_projection:
+            trajectory.message = "; ".join(filter(None, [message, (
+                f"{len(recorder.unconverged)} step(s) whose contact problem did not converge "
+                f"(first: {recorder.unconverged[:5]}); {len(recorder.unconverged_projection)} "
+                f"step(s) whose projection did not converge "
+                f"(first: {recorder.unconverged_projection[:5]})")]))
         return trajectory
 
 
@@ -183,6 +191,8 @@ class _Recorder:
         self.converged = np.ones(samples, dtype=bool)
         self.active = np.zeros(samples, dtype=np.int64)
         self.unconverged: list[int] = []
+        self.solver_seconds = 0.0
+        self.contact_sweeps = 0
         self.unconverged_projection: list[int] = []
         self._iterations = 0
         self._residual = 0.0
@@ -192,6 +202,8 @@ class _Recorder:
     def accumulate(self, result) -> None:
         self._step += 1
         stats = result.statistics
+        self.solver_seconds += stats.solver_seconds
+        self.contact_sweeps += stats.contact_sweeps
         self._iterations += stats.solver_iterations
         self._residual = max(self._residual, stats.solver_residual)
         if not stats.solver_converged:

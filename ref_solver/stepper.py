@@ -10,7 +10,8 @@ One step of length h from state k (Section 2.4 of Akhadkar, Acary, Brogliato 201
    complementarity problem (De Saxcé), solved by :func:`solve_contact_problem`.
 3. Position update x_{k+1} = x_k + h v_theta, p_{k+1} = p_k exp(h Omega_theta).
 4. Projection stage (``projection=True``): Newton iterations on the position constraints of
-   joints, drivers and the contacts of I: a mixed LCP in the multipliers delta
+   joints, drivers and the contacts of I (as equalities g = 0 for the contacts that carry an
+   impulse, as g >= 0 for the others, eq. 21): a mixed LCP in the multipliers delta
    with the correction dq = Mp^-1 H^T delta (Mp: mass for translations, inertia about the
    body's constraint points for rotations, see ``_projection_metric_inverse``), until every
    violation is below ``position_tolerance``.
@@ -104,7 +105,12 @@ class StepperSettings:
 
 @dataclass(frozen=True)
 class StepStatistics:
-    """What one step did (iterations summed over activation rounds)."""
+    """What one step did (iterations summed over activation rounds).
+
+    ``solver_seconds`` is the wall time spent in the one-step contact solver and
+    ``contact_sweeps`` the sum over its solves of (iterations x contacts), so that their ratio
+    is the cost per contact per iteration.
+    """
 
     solver_iterations: int
     solver_residual: float
@@ -115,6 +121,8 @@ class StepStatistics:
     projection_violation: float
     projection_converged: bool
     gyroscopic_iterations: int
+    solver_seconds: float = 0.0
+    contact_sweeps: int = 0
 
 
 @dataclass
@@ -263,14 +271,16 @@ class MoreauJeanStepper:
             active = self._slots(cand, gap_k + 0.5 * h * u_normal <= cfg.activation_margin)
 
         totals = dict(iterations=0, projection_iterations=0)
+        self._solver_seconds = 0.0
+        self._contact_sweeps = 0
         rounds = 0
         while True:
             rounds += 1
-            new_state, impulses, solve = self._velocity_stage(
+            new_state, impulses, solve, closed = self._velocity_stage(
                 state, rotation, nu, free, inverse, cand, active)
             projection = (0, 0.0, True)
             if cfg.projection:
-                projection = self._projection_stage(new_state, active)
+                projection = self._projection_stage(new_state, active, impulses, closed)
             totals["iterations"] += solve.iterations
             totals["projection_iterations"] += projection[0]
             if not cfg.projection:
@@ -289,6 +299,7 @@ class MoreauJeanStepper:
             activation_rounds=rounds, projection_iterations=totals["projection_iterations"],
             projection_violation=float(projection[1]),
             projection_converged=bool(projection[2]), gyroscopic_iterations=int(gyro_iterations),
+            solver_seconds=self._solver_seconds, contact_sweeps=self._contact_sweeps,
         )
         return StepResult(new_state, stats, impulses, cand[3], cand[2], active)
 
@@ -416,6 +427,7 @@ class MoreauJeanStepper:
         m = row_body.shape[0]
         new_nu = free.copy()
         impulses = np.zeros_like(self.previous_impulse)
+        closed = np.zeros(active.shape, dtype=bool)
         if m:
             w, y = delassus(row_body, row_coef, m, inverse, self.cluster,
                             self.cluster_dofs, self.cluster_start)
@@ -437,10 +449,21 @@ class MoreauJeanStepper:
             r0 = np.concatenate((self.previous_bilateral,
                                  self.previous_impulse[pairs, slots].ravel()))
             problem = ContactProblem(w, q, sys_.pair_friction[pairs], n_bilateral=nbil)
+            tick = time.perf_counter()
             solve = self._solve(problem, r0)
+            self._solver_seconds += time.perf_counter() - tick
+            self._contact_sweeps += solve.iterations * len(pairs)
             new_nu = free + (y @ solve.r).reshape(-1, 6)
             self.previous_bilateral = solve.r[:nbil].copy()
             impulses[pairs, slots] = solve.r[nbil:].reshape(-1, 3)
+            if len(pairs):
+                # Contacts that stay closed: they carry a normal impulse and their normal
+                # velocity at the end of the step is (about) zero, not a rebound.
+                u_new = row_values(row_body, row_coef, new_nu, nbil, m)[0::3]
+                normal_impulse = solve.r[nbil:][0::3]
+                floor = 1e-14 * max(float(np.max(np.abs(normal_impulse))), 1e-300)
+                closed[pairs, slots] = (normal_impulse > floor) & (
+                    u_new <= 0.5 * cfg.restitution_threshold)
         else:
             solve = _NO_SOLVE
         new_nu[sys_.body_fixed] = 0.0
@@ -451,9 +474,10 @@ class MoreauJeanStepper:
             if not sys_.body_fixed[b]:
                 p_new[b] = quat_integrate(state.p[b], h * v_theta[b, 3:])
         new_state = State(t1, x_new, p_new, new_nu[:, :3].copy(), new_nu[:, 3:].copy())
-        return new_state, impulses, solve
+        return new_state, impulses, solve, closed
 
-    def _projection_stage(self, state: State, active) -> tuple[int, float, bool]:
+    def _projection_stage(self, state: State, active, impulses, closed) -> tuple[int, float,
+                                                                              bool]:
         """Project positions onto the joint, driver and active-contact constraints in place.
 
         Returns (iterations, largest remaining violation [L], converged)."""
@@ -472,8 +496,20 @@ class MoreauJeanStepper:
                 contact_part = np.zeros(3 * len(pairs), dtype=bool)
                 contact_part[0::3] = True
                 keep[nbil:] = contact_part
-            rows = np.nonzero(keep)[0]
-            n_equal = int(np.count_nonzero(rows < nbil))
+            # Eq. (21) of the study: a contact that transmits a normal impulse (P_N > 0) is
+            # projected to g = 0 (an equality); the others only out of penetration (g >= 0).
+            # Without it a body resting on a contact that closed within the step hovers at the
+            # gap it had (the velocity stage stops it, nothing brings the gap to zero). A
+            # contact whose impulse is a rebound (normal velocity > 0 at the end of the step)
+            # is left unilateral: pulling a bouncing body down to g = 0 would take away the
+            # potential energy of the gap at which the impact was captured.
+            pushing = np.zeros(row_body.shape[0], dtype=bool)
+            if len(pairs):
+                pushing[nbil:][0::3] = closed[pairs, slots]
+            equal = np.nonzero(keep & ((np.arange(len(keep)) < nbil) | pushing))[0]
+            inequal = np.nonzero(keep & ~((np.arange(len(keep)) < nbil) | pushing))[0]
+            rows = np.concatenate((equal, inequal))
+            n_equal = len(equal)
             values = violation[rows]
             equal_error = np.max(np.abs(values[:n_equal])) if n_equal else 0.0
             unilateral_error = max(0.0, -np.min(values[n_equal:])) if len(values) > n_equal \
@@ -505,4 +541,3 @@ class _NoSolve:
 
 
 _NO_SOLVE = _NoSolve()
-_CLOCK = time.perf_counter
