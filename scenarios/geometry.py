@@ -93,6 +93,18 @@ Python side
 :class:`PairContacts`. :func:`pack_shape_parameters`, :func:`shape_code` and
 :func:`supported_pair` / :func:`check_supported_pair` prepare calls of the compiled
 :func:`pair_contacts` from other compiled code.
+
+Compiled callers
+----------------
+``pair_contacts(kind_a, params_a, position_a, rotation_a, kind_b, params_b, position_b,
+rotation_b, out_gap, out_point_a, out_point_b, out_frame) -> count`` is ``njit(inline=
+"always")`` (a thin wrapper that turns its inputs into tuples, so the kernels below it run
+without reference counting). Outputs have K >= MAX_CONTACTS_PER_PAIR rows; ``out_point_a`` and
+``out_point_b`` are also used as work space, so pass distinct arrays. Rotations must be
+orthonormal to round-off (as :func:`quat_to_matrix` gives). An unsupported pair raises
+ValueError inside compiled code too; check :func:`supported_pair` when building the pair list.
+numba's on-disk cache does not notice edits in modules a cached function calls: after editing
+these kernels, clear the ``__pycache__`` numba files (``*.nbi``, ``*.nbc``) of the callers.
 """
 
 from __future__ import annotations
@@ -107,6 +119,7 @@ from .geometry_frames import (
     FRAME_SINGULAR_DIRECTION,
     contact_frame,
     contact_frames_batch,
+    frame_tangent,
     write_contact_frame,
 )
 from .geometry_pairs import (
@@ -147,6 +160,7 @@ __all__ = [
     "contact_frame",
     "contact_frames_batch",
     "contacts_between",
+    "frame_tangent",
     "kind_name",
     "pack_shape_parameters",
     "pair_contacts",

@@ -205,7 +205,7 @@ def test_circle_plane_tilted_lowest_point_closed_form():
                                         params(0.5), (0.0, 0.0, 1.0),
                                         rotation((1, 0, 0), 0.4))
     assert abs(gap[0] - (1.0 - 0.5 * math.sin(0.4))) < 4 * EPS  # a sine and a subtraction
-    assert abs(point_b[0, 2] - gap[0]) < 4 * EPS
+    assert abs(point_b[0, 2] - gap[0]) < 4 * EPS  # the plane is z = 0: same numbers
 
 
 # ------------------------------------------------------------------------------------------------
@@ -438,6 +438,7 @@ def test_tilted_arcs_match_dense_sampling_including_their_ends():
         assert abs(gap[0] - reference) < 1e-9 * 0.02
         ends = [ring_position + ring_rotation @ np.array([math.cos(t), math.sin(t), 0.0])
                 for t in (start, start + span)]
+        # An end point is reproduced to round-off (1e-12 >> ulp of 1, << any arc sampling).
         at_end += any(np.allclose(point_a[0], end, atol=1e-12) for end in ends)
     assert at_end >= 10  # the sample exercises the end-point branch, not only interior minima
 
@@ -452,18 +453,19 @@ def test_arc_excluding_the_nearest_point_returns_its_nearer_end():
                                   IDENTITY, *journal)
     assert abs(gap[0] - end_gap) < 8 * EPS  # closed form of one end point
     assert np.allclose(point_a[0], [math.cos(math.pi / 4), math.sin(math.pi / 4), 0.0],
-                       atol=4 * EPS)
+                       atol=4 * EPS)  # one cos / sin of the end angle
     full = contacts(G.CIRCLE, params(1.0), np.zeros(3), IDENTITY, *journal)[0]
     inside = contacts(G.ARC, params(1.0, -math.pi / 4, math.pi / 4), np.zeros(3), IDENTITY,
                       *journal)[0]
-    assert abs(full[0] - (1.0 - 0.9 - 0.05)) < 8 * EPS
-    assert inside[0] == full[0]
+    assert abs(full[0] - (1.0 - 0.9 - 0.05)) < 8 * EPS  # parallel axes: exact to a few ulp
+    assert inside[0] == full[0]  # same minimiser, same arithmetic
 
 
 def test_arc_plane_returns_the_lower_end_when_the_lowest_point_is_outside():
-    # Vertical circle (axis along y): angle t at height -sin(t) relative... the circle's x axis
-    # stays along x, its y axis points along +z, so the point at angle t is at height sin(t);
-    # lowest at t = -pi/2. An arc over [0, 2] excludes it: the lower end is t = 0 (height 0).
+    # Upright circle: turned 90 degrees about x, its x axis stays along x and its y axis points
+    # up (+z), so the point at angle t is sin(t) radii above the centre; lowest at t = -pi/2.
+    # An arc over [0, 2] excludes it: the lower end is t = 0 (at the centre's height).
+    # Bounds: 4 ulp, one sine / cosine of the angle and a sum.
     upright = rotation((1, 0, 0), math.pi / 2)
     gap, _, point_b, _ = contacts(G.PLANE, params(), np.zeros(3), IDENTITY, G.ARC,
                                   params(0.5, 0.0, 2.0), np.array([0.0, 0.0, 1.0]), upright)
@@ -504,9 +506,10 @@ def test_crossed_boxes_get_the_four_corners_of_their_overlap():
     b = (G.BOX, params(0.1, 1.0, 0.1), np.array([0.0, 0.0, 0.2 - 1e-3]), IDENTITY)
     gap, point_a, point_b, frame = contacts(*a, *b)
     assert gap.shape[0] == 4
+    # Positions O(1), a few operations: 32 ulp.
     assert np.allclose(gap, -1e-3, atol=32 * EPS)
     assert np.allclose(np.sort(np.abs(point_b[:, :2]).ravel()), 0.1, atol=32 * EPS)
-    assert np.allclose(frame[:, 0], [0, 0, 1], atol=0)
+    assert np.allclose(frame[:, 0], [0, 0, 1], atol=0)  # A's z axis, exactly (identity)
 
 
 @pytest.mark.parametrize("gap0", GAPS)
@@ -522,8 +525,8 @@ def test_crossed_edges_give_one_edge_edge_contact(gap0):
     gap, point_a, point_b, frame = contacts(*a, *b)
     assert gap.shape[0] == 1
     assert abs(gap[0] - gap0) < 32 * EPS  # sqrt(2) products on O(1) numbers
-    assert np.allclose(frame[0, 0], [0, 0, 1], atol=1e-15)
-    assert np.allclose(point_a[0], [0.1, 0.0, top], atol=32 * EPS)
+    assert np.allclose(frame[0, 0], [0, 0, 1], atol=1e-15)  # cross product of two unit axes
+    assert np.allclose(point_a[0], [0.1, 0.0, top], atol=32 * EPS)  # as the gap
     assert np.allclose(point_b[0], [0.1, 0.0, top + gap0], atol=32 * EPS)
 
 
@@ -534,8 +537,8 @@ def test_box_on_its_edge_has_its_lowest_candidates_on_that_edge():
     small = (G.BOX, params(0.3, 0.2, 0.1), np.array([0.0, 0.0, 0.5 + corner_drop + 1e-3]), turn)
     big = (G.BOX, params(1.0, 1.0, 0.5), np.zeros(3), IDENTITY)
     gap = np.sort(contacts(*big, *small)[0])
-    assert np.allclose(gap[:2], 1e-3, atol=32 * EPS)
-    assert gap[2] > 1e-3 + 0.1  # the other candidates are well above
+    assert np.allclose(gap[:2], 1e-3, atol=32 * EPS)  # sines of 30 degrees on O(1) numbers
+    assert gap[2] > 1e-3 + 0.1  # the other candidates are well above (0.2 by construction)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -551,8 +554,8 @@ def test_standing_cylinder_gets_four_support_points_on_its_bottom_rim():
     spread = point_b[bottom][:, :2]
     # Four points 90 degrees apart on the rim: a stable support polygon (a square of side
     # 0.4 sqrt(2) centred on the axis).
-    assert np.allclose(spread.mean(axis=0), 0.0, atol=4 * EPS)
-    assert np.allclose(np.linalg.norm(spread, axis=1), 0.4, atol=4 * EPS)
+    assert np.allclose(spread.mean(axis=0), 0.0, atol=4 * EPS)  # exact up to a few ulp
+    assert np.allclose(np.linalg.norm(spread, axis=1), 0.4, atol=4 * EPS)  # likewise
 
 
 def test_lying_cylinder_has_its_two_support_points_first():
@@ -581,9 +584,9 @@ def test_contacts_between_composes_body_and_shape_placements():
     result = G.contacts_between(floor, identity_pose, ball, ball_pose)
     assert result.count == 1 and len(result) == 1
     assert abs(result.gap[0] - 2.5) < 8 * EPS  # quaternion products of exact halves
-    assert np.allclose(result.normal[0], [0, 0, 1], atol=4 * EPS)
+    assert np.allclose(result.normal[0], [0, 0, 1], atol=4 * EPS)  # identity plane axis
     roof = G.contacts_between(ball, ball_pose, ceiling, ((0.0, 0.0, 5.0), (1.0, 0.0, 0.0, 0.0)))
-    assert abs(roof.gap[0] - 1.5) < 8 * EPS
+    assert abs(roof.gap[0] - 1.5) < 8 * EPS  # as above
     assert np.allclose(roof.normal[0], [0, 0, 1], atol=4 * EPS)  # from the ball up to the roof
     with pytest.raises(ValueError):
         roof.gap[0] = 0.0  # results are read-only
