@@ -13,9 +13,10 @@ import math
 import time
 
 import numpy as np
+from numba import njit
+
 from clearbench.scenarios import geometry as G
 from clearbench.scenarios.quaternion import quat_from_axis_angle, quat_to_matrix
-from numba import njit
 
 
 @njit  # not cached: numba cache keys ignore edits of the kernels it calls
