@@ -122,6 +122,7 @@ def build_model(scene: Scene, settings: MujocoSettings, time_step: float) -> Bui
     spec.modelname = scene.name
     spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_FALSE
     spec.compiler.autolimits = True
+    spec.compiler.degree = False  # springref and other angles in radians
     _set_options(spec, scene, settings, time_step)
 
     warnings: list[str] = []
@@ -202,8 +203,6 @@ def build_model(scene: Scene, settings: MujocoSettings, time_step: float) -> Bui
         pair_lookup[key] = pair.contact
     contact_body_b = np.array([model.body(c.body_b).id for c in expanded.contacts],
                               dtype=np.int64)
-    for name, value in controls:
-        data.ctrl[model.actuator(name).id] = value
     for load in python_loads:
         load.body_id = model.body(load.load.body_a if hasattr(load.load, "body_a")
                                   else load.load.body).id
@@ -215,7 +214,9 @@ def build_model(scene: Scene, settings: MujocoSettings, time_step: float) -> Bui
                      for load, body, sign in hinge_springs]
     built = BuiltModel(model, data, topology, body_ids, pair_lookup, contact_body_b, driven,
                        python_loads, rings, parameters, hinge_springs, warnings, notes)
-    _set_initial_state(built, scene)
+    # Preloads are constant motor controls: set after the reset of the initial state.
+    controls = [(model.actuator(name).id, value) for name, value in controls]
+    _set_initial_state(built, scene, controls)
     return built
 
 
@@ -309,15 +310,16 @@ def _add_loads(spec, scene: Scene, topology: Topology, poses, spec_bodies, warni
             site_b = f"{load.name}:b"
             spec_bodies[load.body_a].add_site(name=site_a, pos=list(load.point_a))
             spec_bodies[load.body_b].add_site(name=site_b, pos=list(load.point_b))
-            tendon = spec.add_tendon(name=load.name, stiffness=load.stiffness,
-                                     damping=load.damping,
+            # mujoco 4 springs are polynomials (linear, quadratic, cubic coefficients).
+            tendon = spec.add_tendon(name=load.name, stiffness=[load.stiffness, 0.0, 0.0],
+                                     damping=[load.damping, 0.0, 0.0],
                                      springlength=[load.rest_length, load.rest_length])
             tendon.wrap_site(site_a)
             tendon.wrap_site(site_b)
             if load.preload != 0.0:
                 actuator = spec.add_actuator(name=f"{load.name}:preload", target=load.name,
                                              trntype=mujoco.mjtTrn.mjTRN_TENDON)
-                actuator.set_to_motor(gear=[1.0, 0, 0, 0, 0, 0])
+                actuator.set_to_motor()  # force = ctrl along the tendon (gear 1)
                 actuator.ctrllimited = False
                 # Tension pulls the points together; a positive tendon force lengthens it.
                 controls.append((actuator.name, -load.preload))
@@ -335,13 +337,13 @@ def _add_loads(spec, scene: Scene, topology: Topology, poses, spec_bodies, warni
             body, sign = hinge
             hinge_springs.append((load, body, sign))
             joint = next(j for j in spec_bodies[body].joints)
-            joint.stiffness = load.stiffness
-            joint.damping = load.damping
+            joint.stiffness = [load.stiffness, 0.0, 0.0]
+            joint.damping = [load.damping, 0.0, 0.0]
             joint.springref = sign * load.rest_angle
             if load.preload != 0.0:
                 actuator = spec.add_actuator(name=f"{load.name}:preload", target=joint.name,
                                              trntype=mujoco.mjtTrn.mjTRN_JOINT)
-                actuator.set_to_motor(gear=[1.0, 0, 0, 0, 0, 0])
+                actuator.set_to_motor()
                 actuator.ctrllimited = False
                 controls.append((actuator.name, -sign * load.preload))
         elif isinstance(load, PointForce | Moment):
@@ -398,11 +400,14 @@ def _driven_dofs(model, scene: Scene, topology: Topology,
     return out
 
 
-def _set_initial_state(built: BuiltModel, scene: Scene) -> None:
+def _set_initial_state(built: BuiltModel, scene: Scene, controls: list) -> None:
     """qvel reproducing each body's initial centre-of-mass twist (least squares over the
-    joint velocities that are not driven); the residual is kept for the metadata."""
+    joint velocities that are not driven), and the constant controls of preloads; the
+    residual of the twists is kept for the metadata."""
     model, data = built.model, built.data
     mujoco.mj_resetData(model, data)
+    for actuator, value in controls:
+        data.ctrl[actuator] = value
     for dof in built.driven:
         data.qvel[dof.dof_address] = dof.sign * float(dof.driver.velocity(0.0))
     mujoco.mj_forward(model, data)

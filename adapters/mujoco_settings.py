@@ -34,7 +34,7 @@ PRESETS: dict[str, dict] = {
     # (0.99, 0.999, 1e-5) (a 0.1 mm clearance held within 1.5-2.8 um at dt 1e-4), stiff
     # equalities solref (2 dt, 1) (loop-closure drift 0.034 mm instead of 0.77 mm), convex
     # collision tolerance 1e-4 of the smallest feature (MuJoCo's 1e-6 m is 5 % of a C-60
-    # clearance).
+    # clearance), and e = 0 mapped to dampratio 3 (e = 0.024) instead of 1 (e = 0.135).
     "tuned": {
         "cone": "elliptic",
         "noslip_iterations": 10,
@@ -43,6 +43,7 @@ PRESETS: dict[str, dict] = {
         "equality_timeconst_steps": 2.0,
         "equality_solimp": (0.99, 0.999, 1e-5, 0.5, 2.0),
         "ccd_tolerance_relative": 1e-4,
+        "map_plastic": True,
     },
 }
 

@@ -158,8 +158,9 @@ def plan_topology(scene: Scene) -> Topology:
     problems = []
     for joint in closures:
         if joint.kind == "prismatic":
-            problems.append(("closed_loop", f"prismatic joint {joint.name!r} closes a loop: no "
-                             "MuJoCo equality constraint leaves exactly one sliding freedom"))
+            reason = (f"prismatic joint {joint.name!r} closes a loop: no MuJoCo equality "
+                      "constraint leaves exactly one sliding freedom")
+            problems += [("closed_loop", reason), ("joint:prismatic", reason)]
     driven, driver_problems = _plan_drivers(scene, links, fixed, drivers_of)
     problems += driver_problems
     return Topology(tuple(links), tuple(j.name for j in closures), driven, tuple(problems),

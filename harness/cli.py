@@ -16,6 +16,7 @@ import sys
 COMMAND_MODULES: tuple[str, ...] = (
     "clearbench.harness.cmd_scenes",
     "clearbench.harness.cmd_c60_extract",
+    "clearbench.harness.cmd_bench_mujoco",
     "clearbench.harness.cmd_fclib",
 )
 
