@@ -99,7 +99,7 @@ class MujocoEngine(Engine):
             record.append(steps)
         runner = _Runner(internal, built, config, steps, len(record))
         build_seconds = time.perf_counter() - start
-        status, message = runner.run(record)
+        status, message = _with_logged_warnings(runner, record)
         trajectory = runner.trajectory(scene, internal)
         trajectory.engine = self.name
         trajectory.preset = self.preset
@@ -110,6 +110,25 @@ class MujocoEngine(Engine):
         trajectory.message = message
         trajectory.metadata = _metadata(scene, internal, config, built, runner)
         return trajectory
+
+
+def _with_logged_warnings(runner, record: list[int]) -> tuple[RunStatus, str]:
+    """Run with MuJoCo's text warnings sent to logging (instead of MUJOCO_LOG.TXT in the
+    working directory) and kept for the metadata; the previous handler is restored."""
+    import mujoco
+
+    previous = mujoco.get_mju_user_warning()
+
+    def handler(text: str) -> None:
+        logger.warning("mujoco: %s", text)
+        if len(runner.warnings) < 100:
+            runner.warnings.append(f"mujoco: {text}")
+
+    mujoco.set_mju_user_warning(handler)
+    try:
+        return runner.run(record)
+    finally:
+        mujoco.set_mju_user_warning(previous)
 
 
 def _internal_scene(scene: Scene, config: MujocoSettings) -> Scene:
