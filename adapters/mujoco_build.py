@@ -162,11 +162,11 @@ def build_model(scene: Scene, settings: MujocoSettings, time_step: float) -> Bui
     # pairs
     pairs: list[PairSpec] = []
     parameters: list[ContactParameters] = []
+    users: dict[tuple, list[str]] = {}  # solref -> contact names, to warn once per solref
     for index, contact in enumerate(expanded.contacts):
         chosen = contact_parameters(contact.restitution, settings, time_step)
         parameters.append(chosen)
-        warnings += time_step_warnings(f"contact {contact.name!r}", chosen.solref, time_step,
-                                       settings.refsafe)
+        users.setdefault(tuple(chosen.solref), []).append(contact.name)
         kind_a = expanded.body(contact.body_a).shape(contact.shape_a).kind
         kind_b = expanded.body(contact.body_b).shape(contact.shape_b).kind
         for ga in geoms_of[(contact.body_a, contact.shape_a)]:
@@ -180,6 +180,11 @@ def build_model(scene: Scene, settings: MujocoSettings, time_step: float) -> Bui
                     friction=[contact.friction, contact.friction, 0.0, 0.0, 0.0],
                     solref=list(chosen.solref), solreffriction=list(chosen.solref),
                     solimp=list(chosen.solimp), margin=pair.margin)
+
+    for solref, names in users.items():
+        label = f"contact {names[0]!r}" if len(names) == 1 else \
+            f"{len(names)} contacts ({names[0]!r}, ...)"
+        warnings += time_step_warnings(label, solref, time_step, settings.refsafe)
 
     # loop closures
     equality_solref = (settings.equality_timeconst(time_step), settings.equality_solref[1])

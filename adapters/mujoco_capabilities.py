@@ -106,7 +106,7 @@ def _feature(feature, scene, settings, topology, closures, joint_kind, moving_pl
             "one <pair> per scene pair and geom piece (contype = conaffinity = 0, so nothing "
             "else collides); MuJoCo contacts are soft constraints that let the gap go below "
             f"zero (solref {describe_solref(settings.solref, settings.timeconst_steps)}, "
-            f"solimp {settings.solimp[:3]}); the pair offset is the pair's margin - gap")
+            f"solimp {settings.solimp[:3]}); a pair's offset is its MuJoCo pair margin")
     if feature == "friction":
         if settings.cone == "pyramidal":
             return _approx("pyramidal cone, soft: a body below the friction angle creeps "
@@ -141,7 +141,8 @@ def _feature(feature, scene, settings, topology, closures, joint_kind, moving_pl
             return _approx(f"ring of {settings.ring_pieces} {settings.ring_piece}s per full "
                            "circle: " + "; ".join(ring_summary(scene, settings)))
     if feature in ("rings", "arcs"):
-        return _approx(f"{settings.ring_pieces} convex pieces per full circle (see shape:*)")
+        return _approx(f"{settings.ring_pieces} {settings.ring_piece}s per full circle "
+                       "(see shape:circle / shape:arc)")
     if feature.startswith("pair:"):
         return _native("MuJoCo collision function for the two geom types (one pair per "
                        "piece of a ring)")

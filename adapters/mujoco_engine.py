@@ -6,7 +6,11 @@ Presets (each a separate engine variant ``mujoco[<preset>]``; see :mod:`.mujoco_
 - ``default``: MuJoCo's own defaults (pyramidal cone, solref (0.02, 1), solimp
   (0.9, 0.95, 0.001), Euler, Newton, 100 iterations, no noslip);
 - ``tuned``: elliptic cone + 10 noslip iterations, solref (2 dt, 1), solimp
-  (0.99, 0.999, 1e-5) for contacts and loop closures, as ENGINES.md measured.
+  (0.99, 0.999, 1e-5) for contacts and loop closures, as ENGINES.md measured; plastic pairs
+  (e = 0) mapped to dampratio 3 like every other restitution.
+
+Every pair with e > 0 gets dampratio zeta(e) of a unilateral spring-damper in both presets
+(MuJoCo has no restitution parameter; see :mod:`.mujoco_settings`).
 
 ``RunSettings.options`` override any field of :class:`~.mujoco_settings.MujocoSettings`.
 
@@ -459,7 +463,8 @@ class _Runner:
                                         and np.isfinite(data.qvel).all()):
                 problem = f"non-finite state at step {k} (t = {data.time:.6g})"
             recording = next_record < len(record) and k == record[next_record]
-            if problem is None and (recording or k % interval == 0):
+            checking = self._energy_guard and k % interval == 0
+            if problem is None and (recording or checking):
                 forces = self.contact_forces() if recording else None
                 self.refresh_kinematics()
                 if self._energy_guard:
@@ -467,12 +472,13 @@ class _Runner:
                 if recording:
                     self.store(next_record, forces)
                     next_record += 1
+            elif problem is not None and next_record < len(record):
+                # Keep the offending state as the last sample.
+                forces = self.contact_forces()
+                self.refresh_kinematics()
+                self.store(next_record, forces)
+                next_record += 1
             if problem is not None:
-                if next_record < len(record):
-                    forces = self.contact_forces()
-                    self.refresh_kinematics()
-                    self.store(next_record, forces)
-                    next_record += 1
                 self.count = next_record
                 logger.info("%s: stopped: %s", self.scene.name, problem)
                 return RunStatus.DIVERGED, problem

@@ -9,7 +9,7 @@ from clearbench.adapters.availability import engine_availability
 from clearbench.scenarios.registry import scene_names
 
 from .cli import UserError
-from .expectation_table import DEFAULT_SCENES, markdown, measure
+from .expectation_table import DEFAULT_SCENES, markdown, markdown_compact, measure
 
 
 def register(subparsers) -> None:
@@ -33,6 +33,11 @@ def register(subparsers) -> None:
                         help="simulated duration [scene time unit] (default: each scene's)")
     parser.add_argument("--reference", action="store_true",
                         help="add the reference solver (default preset) as a column")
+    parser.add_argument("--compact", action="store_true",
+                        help="one table for all scenes (a row per scene and figure)")
+    parser.add_argument("--no-mujoco", action="store_true",
+                        help="leave out the MuJoCo columns (with --reference: the reference "
+                        "column alone)")
     parser.set_defaults(handler=run)
 
 
@@ -55,12 +60,15 @@ def run(args) -> int:
     time_steps = tuple(args.time_steps or (1e-3, 1e-4))
     if any(not dt > 0 for dt in time_steps):
         raise UserError(f"--dt must be > 0, got {time_steps}")
-    engines = {f"mujoco[{p}]": mujoco_engine.create(p) for p in presets}
+    engines = {} if args.no_mujoco else \
+        {f"mujoco[{p}]": mujoco_engine.create(p) for p in presets}
+    if not engines and not args.reference:
+        raise UserError("nothing to run: --no-mujoco without --reference")
     if args.reference:
         from clearbench.adapters import reference
 
         engines["reference"] = reference.create()
     measured = measure(engines, time_steps, scenes, args.horizon,
                        progress=lambda text: print(f"running {text}", file=sys.stderr))
-    print(markdown(measured))
+    print(markdown_compact(measured) if args.compact else markdown(measured))
     return 0

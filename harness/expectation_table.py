@@ -45,7 +45,7 @@ TABLE_FIGURES: dict[str, tuple[Figure, ...]] = {
                              100, "%"),),
     "pendulum": (Figure("energy_drift", "energy drift / (m g d)", 100, "%"),
                  Figure("period_relative_error", "period, relative error", 100, "%")),
-    "torque_free": (Figure("angular_momentum_drift", "angular momentum drift / |L0|", 100,
+    "torque_free": (Figure("angular_momentum_drift", "angular momentum drift / L0", 100,
                            "%"),),
     "slider_crank": (Figure("slider_position_max_error", "slider position error", 1e6, "um"),),
     "approaches_ideal": (Figure("clearance_excess", "clearance excess", 1e6, "um"),),
@@ -111,7 +111,7 @@ def table_rows(scene: Scene, cells: list[Cell]) -> list[tuple[str, list[str]]]:
 
 def format_value(value: float, cell: Cell) -> str:
     """Three significant digits; the status when the run did not end OK."""
-    text = "n/a" if not math.isfinite(value) else f"{value:.3g}"
+    text = "n/a" if not math.isfinite(value) else f"{value + 0.0:.3g}"  # no "-0"
     if cell.status is RunStatus.OK:
         return text
     return f"{text} ({cell.status.value})"
@@ -157,4 +157,18 @@ def markdown(measured: list[dict]) -> str:
             lines.append(f"- {note}")
         if notes:
             lines.append("")
+    return "\n".join(lines)
+
+
+def markdown_compact(measured: list[dict]) -> str:
+    """The measurements as one Markdown table: a row per (scene, figure), a column per
+    (engine, time step); runs that did not end OK carry their status."""
+    if not measured:
+        return ""
+    labels = measured[0]["labels"]
+    lines = ["| scene | figure | " + " | ".join(labels) + " |",
+             "|---|---|" + "---:|" * len(labels)]
+    for block in measured:
+        for label, values in block["rows"]:
+            lines.append(f"| {block['scene']} | {label} | " + " | ".join(values) + " |")
     return "\n".join(lines)
