@@ -130,3 +130,42 @@ def plot_clearance_ladder(rungs: list[LadderRung], path) -> None:
     figure.tight_layout()
     figure.savefig(path, dpi=110)
     plt.close(figure)
+
+
+@dataclass(frozen=True)
+class PhysicsRow:
+    """One expectation figure of one run."""
+
+    scene: str
+    time_step: float
+    expectation: str
+    figure: str
+    value: float
+    converged: bool
+    stepping_seconds: float
+
+
+def engine_physics_table(engine_name: str = "reference", preset: str = "default",
+                         time_steps: tuple = (None,), tag: str | None = None) -> list[PhysicsRow]:
+    """Every expectation figure of every library scene (optionally with ``tag``) for one engine
+    and preset, at each of ``time_steps`` (None: the scene's own step) [scene units]."""
+    import importlib
+
+    from clearbench.adapters.availability import ENGINE_MODULES
+    from clearbench.scenarios.registry import scene_names
+
+    from .expectations import evaluate
+
+    module = importlib.import_module(f"clearbench.adapters.{ENGINE_MODULES[engine_name]}")
+    engine = module.create(preset)
+    rows = []
+    for name in scene_names(tag):
+        scene = get_scene(name)
+        for step in time_steps:
+            trajectory = engine.run(scene, RunSettings(time_step=step))
+            for result in evaluate(scene, trajectory):
+                for figure, value in result.figures.items():
+                    rows.append(PhysicsRow(name, trajectory.time_step, result.name, figure,
+                                           value, bool(trajectory.solver_converged.all()),
+                                           trajectory.stepping_seconds))
+    return rows

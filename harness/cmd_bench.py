@@ -42,7 +42,23 @@ def bench_clearance_ladder(args: argparse.Namespace) -> int:
     return 0
 
 
+def bench_reference_physics(args: argparse.Namespace) -> int:
+    from .benchmarks import engine_physics_table
+
+    steps = tuple(float(x) for x in args.dt) if args.dt else (None,)
+    rows = engine_physics_table("reference", "default", steps, args.tag)
+    print("Reference engine against each library scene's expectations (scene units)")
+    print(f"{'scene':<20} {'h':>8} {'expectation':<16} {'figure':<28} {'value':>12} "
+          f"{'converged':>9}")
+    for r in rows:
+        print(f"{r.scene:<20} {r.time_step:>8.0e} {r.expectation:<16} {r.figure:<28} "
+              f"{r.value:>12.3e} {str(r.converged):>9}")
+    return 0
+
+
 BENCHMARKS = {
+    "reference-physics": (bench_reference_physics,
+                          "the reference engine against every scene's expectations"),
     "reference": (bench_reference, "us per step and per contact-iteration of the reference"),
     "clearance-ladder": (bench_clearance_ladder,
                          "clearance pendulum -> ideal pendulum as the clearance shrinks"),
@@ -57,6 +73,8 @@ def register(subparsers) -> None:
     parser.add_argument("name", nargs="?", help="benchmark name (see --list)")
     parser.add_argument("--list", action="store_true", help="list the benchmarks")
     parser.add_argument("--out", help="where a benchmark writes its figure")
+    parser.add_argument("--dt", nargs="+", help="time steps (scene units), where it applies")
+    parser.add_argument("--tag", help="only scenes with this tag, where it applies")
     parser.set_defaults(handler=run)
 
 
