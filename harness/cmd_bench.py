@@ -56,7 +56,30 @@ def bench_reference_physics(args: argparse.Namespace) -> int:
     return 0
 
 
+def bench_flores_reference(args: argparse.Namespace) -> int:
+    from clearbench.adapters.base import RunSettings
+    from clearbench.adapters.reference import create
+    from clearbench.scenarios.registry import get_scene
+
+    from .expectations import evaluate
+
+    scene = get_scene("flores-slider-crank")
+    trajectory = create().run(scene, RunSettings(time_step=1e-5, record_every=10))
+    out = Path(args.out or "reports/trajectories/flores-slider-crank_reference.npz")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    trajectory.save(out)
+    print(f"Flores-Leine-Glocker slider-crank, reference engine, h = 1e-5 s, 0.2 s: "
+          f"{trajectory.steps} steps in {trajectory.stepping_seconds:.1f} s, "
+          f"unconverged steps: {len(trajectory.metadata['unconverged_steps'])}")
+    for result in evaluate(scene, trajectory):
+        print(f"  {result.name}: " + ", ".join(f"{k} = {v:.3e}" for k, v in result.figures.items()))
+    print(f"trajectory (every 10th step): {out}")
+    return 0
+
+
 BENCHMARKS = {
+    "flores-reference": (bench_flores_reference,
+                         "keeps the reference trajectory of the Flores slider-crank (h = 1e-5 s)"),
     "reference-physics": (bench_reference_physics,
                           "the reference engine against every scene's expectations"),
     "reference": (bench_reference, "us per step and per contact-iteration of the reference"),
