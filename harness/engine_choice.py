@@ -102,10 +102,19 @@ def resolve_engine(text: str, extra_modules: Mapping[str, str] | None = None,
         except Exception as error:
             raise RunInputError(f"{field} preset", preset, f"{name} refused it: {error}") \
                 from None
-    option_names = getattr(module, "OPTION_NAMES", None)
-    if options and option_names is not None:
-        unknown = sorted(set(options) - set(option_names))
-        if unknown:
-            raise RunInputError("options", ", ".join(unknown),
-                                f"unknown {name} options; options: {', '.join(option_names)}")
-    return EngineChoice(name, preset, module_path, str(detail))
+    choice = EngineChoice(name, preset, module_path, str(detail))
+    check_options(choice, options)
+    return choice
+
+
+def check_options(choice: EngineChoice, options: Mapping | None) -> None:
+    """RunInputError when an option is unknown to an adapter that declares OPTION_NAMES."""
+    if not options:
+        return
+    option_names = getattr(importlib.import_module(choice.module), "OPTION_NAMES", None)
+    if option_names is None:
+        return
+    unknown = sorted(set(options) - set(option_names))
+    if unknown:
+        raise RunInputError("options", ", ".join(unknown),
+                            f"unknown {choice.name} options; options: {', '.join(option_names)}")

@@ -19,12 +19,12 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from clearbench.scenarios.registry import get_entry
+from clearbench.scenarios.registry import get_entry, scene_names
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.serialization import load_scene_file, scene_to_dict
 from clearbench.scenarios.validation import SceneError
 
-from .engine_choice import EngineChoice, RunInputError, resolve_engine
+from .engine_choice import EngineChoice, RunInputError, check_options, resolve_engine
 
 #: Wall-clock limit of one run when none is given [s].
 DEFAULT_TIMEOUT = 600.0
@@ -97,8 +97,9 @@ def resolve_scene(scene: str | Path | Scene, parameters: Mapping | None = None) 
             raise RunInputError("scene", text, f"invalid scene file: {error}") from None
     try:
         entry = get_entry(text)
-    except KeyError as error:
-        raise RunInputError("scene", text, str(error.args[0]).split(": ", 1)[-1]) from None
+    except KeyError:
+        raise RunInputError("scene", text, "neither a registered scene nor a scene file; "
+                            f"registered scenes: {', '.join(scene_names())}") from None
     accepted = _factory_parameters(entry.factory)
     for key in parameters:
         if accepted is not None and key not in accepted:
@@ -246,6 +247,8 @@ def make_run_spec(scene: str | Path | Scene, engine: str, *,
     options = dict(options or {})
     for key, value in options.items():
         _jsonable(f"options.{key}", value)
+    if engine_choice is not None:
+        check_options(engine_choice, options)
     choice = engine_choice or resolve_engine(engine, extra_engine_modules, options)
     if time_step is not None and time_step_factor is not None:
         raise RunInputError("time_step", time_step, "give a time step or a factor, not both")
