@@ -98,10 +98,11 @@ class RunRecord:
     def from_worker(cls, spec: RunSpec, ran: dict, measured: dict, revision: dict,
                     machine: dict) -> RunRecord:
         """Assemble a row from the spec and the worker's two messages."""
-        engine_status = ran.get("status", RunStatus.CRASHED.value)
-        status = measured.get("verdict") or engine_status
+        guarded = ran.get("status", RunStatus.CRASHED.value)
+        engine_status = ran.get("engine_status", guarded)
+        status = measured.get("verdict") or guarded
         message = ran.get("message", "")
-        if measured.get("verdict") and measured["verdict"] != engine_status:
+        if measured.get("verdict") and measured["verdict"] != guarded:
             message = measured.get("verdict_reason", "") or message
         stepping = float(ran.get("stepping_seconds", math.nan))
         steps = int(ran.get("steps", 0) or 0)
@@ -127,7 +128,7 @@ class RunRecord:
             status=status,
             message=message,
             engine_status=engine_status,
-            engine_message=ran.get("message", ""),
+            engine_message=ran.get("engine_message", ran.get("message", "")),
             worker_seconds=float(ran.get("worker_seconds", math.nan)),
             build_seconds=float(ran.get("build_seconds", math.nan)),
             stepping_seconds=stepping,

@@ -106,6 +106,7 @@ def run_phase(request: dict):
                                options=dict(request["options"]))
         trajectory = engine.run(scene, settings)
         status, message = trajectory.status, trajectory.message
+        ran["engine_status"], ran["engine_message"] = status.value, message
         if status is RunStatus.OK:
             bad = first_non_finite(trajectory)
             if bad is not None:

@@ -13,7 +13,8 @@ Presets misbehave on purpose:
 
 Options: ``sleep`` (seconds to sleep before running), ``bias`` (added to every z [L]). The
 environment variable ``CLEARBENCH_FAKE_BIAS`` adds to ``bias`` (to inject a regression without
-touching a suite definition). Clearance joints are reported unsupported.
+touching a suite definition), and ``CLEARBENCH_FAKE_NAN`` (non-empty) makes every preset behave
+as ``nan``. Clearance joints are reported unsupported.
 """
 
 from __future__ import annotations
@@ -122,7 +123,7 @@ class FakeEngine(Engine):
                 out["angular_velocities"][slot] = w
                 slot += 1
         stepping = time.perf_counter() - start
-        if self.preset == "nan":
+        if self.preset == "nan" or os.environ.get("CLEARBENCH_FAKE_NAN"):
             out["positions"][count // 2:] = np.nan
         return Trajectory(
             engine=self.name, preset=self.preset, scene_name=scene.name,
