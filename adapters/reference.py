@@ -2,14 +2,16 @@
 
 Presets (each a separate engine variant in results):
 
-- ``default``: theta = 1/2, combined projection on, NSGS with exact Alart–Curnier local solves,
-  tolerance 1e-12 (|F| / max(|q|, |r|, |u|)).
+- ``default``: theta = 1/2, combined projection on, NSGS with exact Alart–Curnier local solves
+  switching to the semismooth Newton solver when NSGS stalls (``hybrid``), tolerance 1e-12
+  (|F| / max(|q|, |r|, |u|)).
 - ``no-projection``: plain Moreau–Jean (Moreau's activation g + h/2 u_N <= 0).
 - ``newton``: as default with the semismooth Newton one-step solver.
 - ``implicit``: theta = 1 (more dissipative, unconditionally stable for stiff springs).
 
 Options (``RunSettings.options``) override: ``theta``, ``projection``, ``method``,
-``tolerance``, ``max_iterations``, ``position_tolerance``.
+``tolerance``, ``max_iterations``, ``position_tolerance``, ``restitution_threshold`` (default
+2 |g| h: slower impacts are plastic, see :class:`StepperSettings`).
 """
 
 from __future__ import annotations
@@ -29,13 +31,14 @@ from .reference_build import build_system, feature_lengths, initial_state
 from .trajectory import RunStatus, Trajectory
 
 PRESETS: dict[str, dict] = {
-    "default": {"theta": 0.5, "projection": True, "method": "nsgs"},
-    "no-projection": {"theta": 0.5, "projection": False, "method": "nsgs"},
+    "default": {"theta": 0.5, "projection": True, "method": "hybrid"},
+    "no-projection": {"theta": 0.5, "projection": False, "method": "hybrid"},
+    "nsgs": {"theta": 0.5, "projection": True, "method": "nsgs"},
     "newton": {"theta": 0.5, "projection": True, "method": "newton"},
-    "implicit": {"theta": 1.0, "projection": True, "method": "nsgs"},
+    "implicit": {"theta": 1.0, "projection": True, "method": "hybrid"},
 }
 OPTION_NAMES = ("theta", "projection", "method", "tolerance", "max_iterations",
-                "position_tolerance")
+                "position_tolerance", "restitution_threshold")
 
 
 def availability() -> tuple[bool, str]:
@@ -83,7 +86,8 @@ class ReferenceEngine(Engine):
         lengths = feature_lengths(scene)
         smallest = min(lengths) if lengths else 1.0
         largest = max(lengths) if lengths else 1.0
-        solver = SolverOptions(method=options["method"],
+        method = options["method"]
+        solver = SolverOptions(method="nsgs" if method == "hybrid" else method,
                                tolerance=float(options.get("tolerance", 1e-12)),
                                max_iterations=int(options.get("max_iterations", 10_000)))
         return StepperSettings(
@@ -96,6 +100,13 @@ class ReferenceEngine(Engine):
             position_tolerance=float(options.get("position_tolerance", 1e-10 * smallest)),
             activation_margin=1e-10 * smallest,
             length_scale=largest,
+            method=method,
+            # Bounces slower than two steps' worth of gravity cannot be resolved by the fixed
+            # step; they are taken as plastic so that bodies come to rest (see StepperSettings).
+            restitution_threshold=float(options.get(
+                "restitution_threshold",
+                2.0 * float(np.linalg.norm(scene.gravity)) * (settings.time_step
+                                                               or scene.time_step))),
         )
 
     def _run(self, scene: Scene, settings: RunSettings) -> Trajectory:
@@ -142,11 +153,19 @@ class ReferenceEngine(Engine):
         trajectory.message = message
         trajectory.metadata = {
             "theta": config.theta, "projection": config.projection,
-            "solver": config.solver.method, "tolerance": config.solver.tolerance,
+            "solver": config.method, "tolerance": config.solver.tolerance,
             "position_tolerance": config.position_tolerance,
             "unconverged_steps": recorder.unconverged,
             "unconverged_projections": recorder.unconverged_projection,
+            "solver_seconds": recorder.solver_seconds,
+            "contact_sweeps": recorder.contact_sweeps,
         }
+        if recorder.unconverged or recorder.unconverged_projection:
+            trajectory.message = "; ".join(filter(None, [message, (
+                f"{len(recorder.unconverged)} step(s) whose contact problem did not converge "
+                f"(first: {recorder.unconverged[:5]}); {len(recorder.unconverged_projection)} "
+                f"step(s) whose projection did not converge "
+                f"(first: {recorder.unconverged_projection[:5]})")]))
         return trajectory
 
 
@@ -172,6 +191,8 @@ class _Recorder:
         self.converged = np.ones(samples, dtype=bool)
         self.active = np.zeros(samples, dtype=np.int64)
         self.unconverged: list[int] = []
+        self.solver_seconds = 0.0
+        self.contact_sweeps = 0
         self.unconverged_projection: list[int] = []
         self._iterations = 0
         self._residual = 0.0
@@ -181,6 +202,8 @@ class _Recorder:
     def accumulate(self, result) -> None:
         self._step += 1
         stats = result.statistics
+        self.solver_seconds += stats.solver_seconds
+        self.contact_sweeps += stats.contact_sweeps
         self._iterations += stats.solver_iterations
         self._residual = max(self._residual, stats.solver_residual)
         if not stats.solver_converged:

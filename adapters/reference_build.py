@@ -108,6 +108,7 @@ def build_system(scene: Scene) -> MultibodySystem:
         relative.append(quat_multiply(quat_conjugate(p[a]), p[b]))
     # drivers
     dbody, dcomp, dquant, dstart, dtimes, dvalues, dinit = [], [], [], [0], [], [], []
+    dref = []
     for driver in scene.drivers:
         b = index[driver.body]
         component = COMPONENTS.index(driver.component)
@@ -118,6 +119,7 @@ def build_system(scene: Scene) -> MultibodySystem:
         dvalues.extend(driver.values)
         dstart.append(len(dtimes))
         dinit.append(x[b, component] if component < 3 else 0.0)
+        dref.append(p[b])
     # force elements
     fk, fa, fb, fp = [], [], [], []
     for load in scene.loads:
@@ -180,7 +182,7 @@ def build_system(scene: Scene) -> MultibodySystem:
         driver_body=arr(dbody, (-1,), np.int64), driver_component=arr(dcomp, (-1,), np.int64),
         driver_quantity=arr(dquant, (-1,), np.int64), driver_start=arr(dstart, (-1,), np.int64),
         driver_times=arr(dtimes, (-1,)), driver_values=arr(dvalues, (-1,)),
-        driver_initial=arr(dinit, (-1,)),
+        driver_initial=arr(dinit, (-1,)), driver_reference=arr(dref, (-1, 4)),
         force_kind=arr(fk, (-1,), np.int64), force_body_a=arr(fa, (-1,), np.int64),
         force_body_b=arr(fb, (-1,), np.int64), force_parameters=arr(fp, (-1, 24)),
         body_names=tuple(b.name for b in scene.bodies),
@@ -204,4 +206,11 @@ def feature_lengths(scene: Scene) -> list[float]:
     for contact in scene.all_contacts:
         if contact.offset > 0:
             lengths.append(contact.offset)
+    # Joint lever arms: distance from each body's centre of mass to its joint anchors.
+    x, _, _ = body_frames(scene)
+    for joint in scene.joints:
+        for name in (joint.body_a, joint.body_b):
+            if scene.body(name).motion is not Motion.FIXED:
+                lengths.append(float(np.linalg.norm(np.asarray(joint.anchor)
+                                                    - x[scene.body_index(name)])))
     return [length for length in lengths if length > 0 and math.isfinite(length)]

@@ -44,8 +44,8 @@ def _angular_row(coef, rotation, direction, sign):
 @njit(cache=True)
 def bilateral_rows(t, x, p, rotation, fixed, joint_kind, joint_a, joint_b, anchor_a, anchor_b,
                    frame_a, axis_b, relative0, driver_body, driver_component, driver_quantity,
-                   driver_start, driver_times, driver_values, driver_initial, row_body,
-                   row_coef, violation, velocity_target):
+                   driver_start, driver_times, driver_values, driver_initial,
+                   driver_reference, row_body, row_coef, violation, velocity_target):
     """Fill the bilateral rows of joints then drivers.
 
     Parameters
@@ -53,7 +53,8 @@ def bilateral_rows(t, x, p, rotation, fixed, joint_kind, joint_a, joint_b, ancho
     row_body : (m, 2) int, out
     row_coef : (m, 2, 6), out
     violation : (m,), out
-        Position-level residual of each row (driver rows of rotations: 0, no position level).
+        Position-level residual of each row. For rotation drivers: the rotation about the world
+        axis since t = 0 (twist of p p0^-1) minus the prescribed angle, wrapped to (-pi, pi].
     velocity_target : (m,), out
         Required value of the row at the end of the step (non-zero for drivers only).
     """
@@ -134,7 +135,11 @@ def bilateral_rows(t, x, p, rotation, fixed, joint_kind, joint_a, joint_b, ancho
             violation[row] = x[b, component] - driver_initial[d] - displacement
         else:
             _angular_row(row_coef[row, 1], rotation[b], e_r, 1.0)
-            violation[row] = 0.0
+            change = quat_multiply(p[b], quat_conjugate(driver_reference[d]))
+            axis = component - 3
+            twist = 2.0 * math.atan2(change[1 + axis], change[0])
+            error = twist - profile_displacement(times, values, driver_quantity[d], t)
+            violation[row] = (error + math.pi) % (2.0 * math.pi) - math.pi
         velocity_target[row] = rate
         row += 1
     return row
@@ -306,4 +311,3 @@ def delassus(row_body, row_coef, m, inverse_blocks, cluster, cluster_dofs, clust
 
 
 KMAX = MAX_CONTACTS_PER_PAIR
-_unused = math.pi

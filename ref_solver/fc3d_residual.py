@@ -24,7 +24,9 @@ from .contact_problem import Normalisation
 def project_on_cone(x0: float, x1: float, x2: float, mu: float) -> tuple[float, float, float]:
     """Euclidean projection of x = (x_N, x_T1, x_T2) on K = {|x_T| <= mu x_N}."""
     norm_t = math.hypot(x1, x2)
-    if norm_t <= mu * x0:  # inside K
+    # x0 >= 0 matters for mu = 0, where K is the ray {x_T = 0, x_N >= 0}: without it a point
+    # (x_N < 0, 0, 0) passes as inside K, since 0 <= 0 * x_N = -0.0 holds in IEEE arithmetic.
+    if x0 >= 0.0 and norm_t <= mu * x0:  # inside K
         return x0, x1, x2
     if mu * norm_t <= -x0:  # inside the polar cone -K*: projection is the apex
         return 0.0, 0.0, 0.0

@@ -10,9 +10,11 @@ One step of length h from state k (Section 2.4 of Akhadkar, Acary, Brogliato 201
    complementarity problem (De Saxcé), solved by :func:`solve_contact_problem`.
 3. Position update x_{k+1} = x_k + h v_theta, p_{k+1} = p_k exp(h Omega_theta).
 4. Projection stage (``projection=True``): Newton iterations on the position constraints of
-   joints, translational drivers and the contacts of I: a mixed LCP in the multipliers delta
-   with the mass-weighted correction dq = M^-1 H^T delta, until every violation is below
-   ``position_tolerance``.
+   joints, drivers and the contacts of I (as equalities g = 0 for the contacts that carry an
+   impulse, as g >= 0 for the others, eq. 21): a mixed LCP in the multipliers delta
+   with the correction dq = Mp^-1 H^T delta (Mp: mass for translations, inertia about the
+   body's constraint points for rotations, see ``_projection_metric_inverse``), until every
+   violation is below ``position_tolerance``.
 5. Activation stage: I <- I U {alpha : g_alpha(q_{k+1}) <= 0}; when I grew, the step is redone
    from state k (eq. 22). I starts as the contacts already closed at q_k (gap <= the activation
    margin); without projection it starts as Moreau's prediction g + (h/2) u_N <= 0.
@@ -24,7 +26,7 @@ flagged there, never hidden.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -42,7 +44,7 @@ from .contact_problem import ContactProblem, SolverOptions
 from .fc3d_solve import solve_contact_problem
 from .forces import applied_forces, rotation_matrices, spring_jacobians
 from .gyroscopic import gyroscopic_update
-from .mlcp import solve_mlcp
+from .projection import solve_projection
 from .system import MultibodySystem, State
 
 
@@ -69,6 +71,14 @@ class StepperSettings:
         of the step [L].
     length_scale : float
         Characteristic length [L] for finite-difference steps of the spring stiffness.
+    method : str
+        ``nsgs``, ``newton`` or ``hybrid`` (NSGS for at most ``hybrid_sweeps`` sweeps, then
+        Newton from where it stopped).
+    restitution_threshold : float
+        Impacts with a normal approach speed below this [L/T] are plastic (e = 0). A bounce of
+        speed v under gravity g lasts 2 v / g; below about g h it fits within one step and a
+        fixed-step scheme cannot resolve it: with e > 0 a resting body would chatter at an
+        amplitude of order e^2 g h^2 instead of coming to rest. 0 disables the threshold.
     """
 
     time_step: float
@@ -80,6 +90,9 @@ class StepperSettings:
     max_activation_rounds: int = 20
     activation_margin: float = 1e-12
     length_scale: float = 1.0
+    method: str = "hybrid"
+    hybrid_sweeps: int = 100
+    restitution_threshold: float = 0.0
 
     def __post_init__(self) -> None:
         if not self.time_step > 0.0:
@@ -92,7 +105,12 @@ class StepperSettings:
 
 @dataclass(frozen=True)
 class StepStatistics:
-    """What one step did (iterations summed over activation rounds)."""
+    """What one step did (iterations summed over activation rounds).
+
+    ``solver_seconds`` is the wall time spent in the one-step contact solver and
+    ``contact_sweeps`` the sum over its solves of (iterations x contacts), so that their ratio
+    is the cost per contact per iteration.
+    """
 
     solver_iterations: int
     solver_residual: float
@@ -103,6 +121,8 @@ class StepStatistics:
     projection_violation: float
     projection_converged: bool
     gyroscopic_iterations: int
+    solver_seconds: float = 0.0
+    contact_sweeps: int = 0
 
 
 @dataclass
@@ -143,6 +163,7 @@ class MoreauJeanStepper:
             inverse[r, r] = system.inverse_inertia[b]
         self.mass_matrix = mass_matrix
         self.inverse_mass = inverse
+        self.projection_inverse = self._projection_metric_inverse(system)
         self._clusters(system)
         npair = system.pair_count
         k = MAX_CONTACTS_PER_PAIR
@@ -153,6 +174,35 @@ class MoreauJeanStepper:
                                 np.arange(0, 6 * nb + 1, 6, dtype=np.int64))
 
     # ------------------------------------------------------------------ set-up
+    @staticmethod
+    def _projection_metric_inverse(system: MultibodySystem) -> np.ndarray:
+        """Inverse of the metric of the position projection, (6 nb, 6 nb) block diagonal.
+
+        Translations weigh the mass m; rotations weigh J + m rho^2 I, the inertia about the
+        body's farthest constraint point (shape origins and joint anchors, at distance rho
+        from the centre of mass). With the plain mass matrix, a light body whose centre of
+        mass is far from its joints (a pendulum bob) is corrected by rotating it about its
+        centre of mass, which swings the joint tangentially by more than a tight clearance and
+        the Newton projection does not converge. Any symmetric positive definite metric
+        projects onto the same constraint manifold; this one is scale invariant.
+        """
+        nb = system.body_count
+        rho = np.zeros(nb)
+        for shape, body in enumerate(system.shape_body):
+            rho[body] = max(rho[body], float(np.linalg.norm(system.shape_position[shape])))
+        for j in range(system.joint_kind.shape[0]):
+            for body, anchor in ((system.joint_body_a[j], system.joint_anchor_a[j]),
+                                 (system.joint_body_b[j], system.joint_anchor_b[j])):
+                rho[body] = max(rho[body], float(np.linalg.norm(anchor)))
+        out = np.zeros((6 * nb, 6 * nb))
+        for b in range(nb):
+            if system.body_fixed[b]:
+                continue
+            out[6 * b:6 * b + 3, 6 * b:6 * b + 3] = np.eye(3) / system.mass[b]
+            angular = system.inertia[b] + system.mass[b] * rho[b] ** 2 * np.eye(3)
+            out[6 * b + 3:6 * b + 6, 6 * b + 3:6 * b + 6] = np.linalg.inv(angular)
+        return out
+
     def _clusters(self, system: MultibodySystem) -> None:
         """Bodies coupled by springs form clusters; the iteration matrix is block diagonal
         over clusters (each body alone when there is no spring)."""
@@ -221,14 +271,16 @@ class MoreauJeanStepper:
             active = self._slots(cand, gap_k + 0.5 * h * u_normal <= cfg.activation_margin)
 
         totals = dict(iterations=0, projection_iterations=0)
+        self._solver_seconds = 0.0
+        self._contact_sweeps = 0
         rounds = 0
         while True:
             rounds += 1
-            new_state, impulses, solve = self._velocity_stage(
+            new_state, impulses, solve, closed = self._velocity_stage(
                 state, rotation, nu, free, inverse, cand, active)
             projection = (0, 0.0, True)
             if cfg.projection:
-                projection = self._projection_stage(new_state, active)
+                projection = self._projection_stage(new_state, active, impulses, closed)
             totals["iterations"] += solve.iterations
             totals["projection_iterations"] += projection[0]
             if not cfg.projection:
@@ -247,10 +299,41 @@ class MoreauJeanStepper:
             activation_rounds=rounds, projection_iterations=totals["projection_iterations"],
             projection_violation=float(projection[1]),
             projection_converged=bool(projection[2]), gyroscopic_iterations=int(gyro_iterations),
+            solver_seconds=self._solver_seconds, contact_sweeps=self._contact_sweeps,
         )
         return StepResult(new_state, stats, impulses, cand[3], cand[2], active)
 
     # ------------------------------------------------------------------ pieces
+    def _solve(self, problem: ContactProblem, r0: np.ndarray):
+        """One-step problem: NSGS, Newton, or ``hybrid``.
+
+        ``hybrid``: NSGS for at most ``hybrid_sweeps`` sweeps from the warm start; when it has
+        not converged, semismooth Newton from where NSGS stopped, then from the warm start, then
+        from zero, then NSGS to its full cap from zero and from where it stopped, keeping the
+        first that converges (else the smallest residual). Redundant
+        contacts (the two rings of a bearing) make W singular: NSGS crawls there and Newton can
+        stall from a poor start, while another start converges in a few iterations.
+        """
+        cfg = self.settings
+        if cfg.method != "hybrid":
+            return solve_contact_problem(problem, replace(cfg.solver, method=cfg.method), r0=r0)
+        best = solve_contact_problem(
+            problem, replace(cfg.solver, method="nsgs", max_iterations=cfg.hybrid_sweeps), r0=r0)
+        if best.converged:
+            return best
+        iterations = best.iterations
+        newton = replace(cfg.solver, method="newton", max_iterations=200)
+        nsgs = replace(cfg.solver, method="nsgs")
+        attempts = ((newton, best.r), (newton, r0), (newton, None), (nsgs, None), (nsgs, best.r))
+        for options, start in attempts:
+            attempt = solve_contact_problem(problem, options, r0=start)
+            iterations += attempt.iterations
+            if attempt.converged or attempt.residual < best.residual:
+                best = attempt
+            if attempt.converged:
+                break
+        return replace(best, iterations=iterations)
+
     def _cluster_inverse(self, matrix: np.ndarray) -> np.ndarray:
         out = np.zeros_like(matrix)
         for c in range(len(self.cluster_start) - 1):
@@ -286,8 +369,10 @@ class MoreauJeanStepper:
         valid = np.arange(mask.shape[1])[None, :] < count[:, None]
         return mask & valid
 
-    def _rows(self, t, x, p, rotation, cand, active):
-        """Bilateral rows then 3 rows per active contact."""
+    def _rows(self, t, x, p, rotation, cand, active, bilateral_at=None):
+        """Bilateral rows then 3 rows per active contact (contact rows at (x, rotation), where
+        the candidates were computed; bilateral rows at ``bilateral_at`` = (x, p, rotation)
+        when given)."""
         sys_ = self.system
         nbil = sys_.bilateral_row_count
         pairs, slots = np.nonzero(active)
@@ -297,13 +382,14 @@ class MoreauJeanStepper:
         violation = np.zeros(m)
         target = np.zeros(m)
         if nbil:
-            bilateral_rows(t, x, p, rotation, sys_.body_fixed, sys_.joint_kind,
+            bx, bp, brot = bilateral_at if bilateral_at is not None else (x, p, rotation)
+            bilateral_rows(t, bx, bp, brot, sys_.body_fixed, sys_.joint_kind,
                            sys_.joint_body_a, sys_.joint_body_b, sys_.joint_anchor_a,
                            sys_.joint_anchor_b, sys_.joint_frame_a, sys_.joint_axis_b,
                            sys_.joint_relative_rotation, sys_.driver_body,
                            sys_.driver_component, sys_.driver_quantity, sys_.driver_start,
                            sys_.driver_times, sys_.driver_values, sys_.driver_initial,
-                           row_body, row_coef, violation, target)
+                           sys_.driver_reference, row_body, row_coef, violation, target)
         if len(pairs):
             contact_rows(x, rotation, sys_.body_fixed, sys_.shape_body, sys_.pair_shape_a,
                          sys_.pair_shape_b, pairs.astype(np.int64), slots.astype(np.int64),
@@ -327,27 +413,57 @@ class MoreauJeanStepper:
         cfg = self.settings
         h, theta = cfg.time_step, cfg.theta
         t1 = state.t + h
+        # Joint Jacobians at the predicted configuration q_k + theta h v_k: with theta = 1/2
+        # this makes ideal joints second order in energy (at q_k the energy error is O(h)).
+        x_mid = state.x + theta * h * state.v
+        p_mid = state.p.copy()
+        for b in range(sys_.body_count):
+            if not sys_.body_fixed[b]:
+                p_mid[b] = quat_integrate(state.p[b], theta * h * state.omega[b])
         row_body, row_coef, _, target, pairs, slots = self._rows(
-            t1, state.x, state.p, rotation, cand, active)
+            t1, state.x, state.p, rotation, cand, active,
+            bilateral_at=(x_mid, p_mid, rotation_matrices(p_mid)))
         nbil = sys_.bilateral_row_count
         m = row_body.shape[0]
         new_nu = free.copy()
         impulses = np.zeros_like(self.previous_impulse)
+        closed = np.zeros(active.shape, dtype=bool)
         if m:
             w, y = delassus(row_body, row_coef, m, inverse, self.cluster,
                             self.cluster_dofs, self.cluster_start)
             q = row_values(row_body, row_coef, free, 0, m) - target
+            joint_rows = nbil - sys_.driver_body.shape[0]
+            if joint_rows:
+                # Ideal joints constrain the mid-step velocity, H_mid (theta v_{k+1} +
+                # (1 - theta) v_k) = 0: with constant forces the step then conserves energy
+                # exactly (v_mid . H^T lambda = 0), so the energy error of ideal joints is
+                # O(h^2) instead of the O(h) loss of H v_{k+1} = 0 (ENGINES.md, Siconos).
+                q[:joint_rows] += (1.0 - theta) / theta * row_values(
+                    row_body, row_coef, nu, 0, joint_rows)
             if len(pairs):
                 u_k = row_values(row_body, row_coef, nu, nbil, m)[0::3]
                 e = sys_.pair_restitution[pairs]
-                q[nbil:][0::3] += e * np.minimum(u_k, 0.0)
+                # Newton's law only for impacts faster than the threshold (see settings).
+                impacting = u_k < -cfg.restitution_threshold
+                q[nbil:][0::3] += np.where(impacting, e * u_k, 0.0)
             r0 = np.concatenate((self.previous_bilateral,
                                  self.previous_impulse[pairs, slots].ravel()))
             problem = ContactProblem(w, q, sys_.pair_friction[pairs], n_bilateral=nbil)
-            solve = solve_contact_problem(problem, cfg.solver, r0=r0)
+            tick = time.perf_counter()
+            solve = self._solve(problem, r0)
+            self._solver_seconds += time.perf_counter() - tick
+            self._contact_sweeps += solve.iterations * len(pairs)
             new_nu = free + (y @ solve.r).reshape(-1, 6)
             self.previous_bilateral = solve.r[:nbil].copy()
             impulses[pairs, slots] = solve.r[nbil:].reshape(-1, 3)
+            if len(pairs):
+                # Contacts that stay closed: they carry a normal impulse and their normal
+                # velocity at the end of the step is (about) zero, not a rebound.
+                u_new = row_values(row_body, row_coef, new_nu, nbil, m)[0::3]
+                normal_impulse = solve.r[nbil:][0::3]
+                floor = 1e-14 * max(float(np.max(np.abs(normal_impulse))), 1e-300)
+                closed[pairs, slots] = (normal_impulse > floor) & (
+                    u_new <= 0.5 * cfg.restitution_threshold)
         else:
             solve = _NO_SOLVE
         new_nu[sys_.body_fixed] = 0.0
@@ -358,16 +474,16 @@ class MoreauJeanStepper:
             if not sys_.body_fixed[b]:
                 p_new[b] = quat_integrate(state.p[b], h * v_theta[b, 3:])
         new_state = State(t1, x_new, p_new, new_nu[:, :3].copy(), new_nu[:, 3:].copy())
-        return new_state, impulses, solve
+        return new_state, impulses, solve, closed
 
-    def _projection_stage(self, state: State, active) -> tuple[int, float, bool]:
+    def _projection_stage(self, state: State, active, impulses, closed) -> tuple[int, float,
+                                                                              bool]:
         """Project positions onto the joint, driver and active-contact constraints in place.
 
         Returns (iterations, largest remaining violation [L], converged)."""
         sys_ = self.system
         cfg = self.settings
         nbil = sys_.bilateral_row_count
-        rotation_driver = sys_.driver_component >= 3
         worst = 0.0
         for iteration in range(cfg.max_projection_iterations + 1):
             rotation = rotation_matrices(state.p)
@@ -375,16 +491,25 @@ class MoreauJeanStepper:
             row_body, row_coef, violation, _, pairs, slots = self._rows(
                 state.t, state.x, state.p, rotation, cand, active)
             keep = np.ones(row_body.shape[0], dtype=bool)
-            if nbil:
-                joint_rows = nbil - len(sys_.driver_body)
-                keep[joint_rows:nbil] = ~rotation_driver
             # Contacts: only the normal rows take part in the projection.
             if len(pairs):
                 contact_part = np.zeros(3 * len(pairs), dtype=bool)
                 contact_part[0::3] = True
                 keep[nbil:] = contact_part
-            rows = np.nonzero(keep)[0]
-            n_equal = int(np.count_nonzero(rows < nbil))
+            # Eq. (21) of the study: a contact that transmits a normal impulse (P_N > 0) is
+            # projected to g = 0 (an equality); the others only out of penetration (g >= 0).
+            # Without it a body resting on a contact that closed within the step hovers at the
+            # gap it had (the velocity stage stops it, nothing brings the gap to zero). A
+            # contact whose impulse is a rebound (normal velocity > 0 at the end of the step)
+            # is left unilateral: pulling a bouncing body down to g = 0 would take away the
+            # potential energy of the gap at which the impact was captured.
+            pushing = np.zeros(row_body.shape[0], dtype=bool)
+            if len(pairs):
+                pushing[nbil:][0::3] = closed[pairs, slots]
+            equal = np.nonzero(keep & ((np.arange(len(keep)) < nbil) | pushing))[0]
+            inequal = np.nonzero(keep & ~((np.arange(len(keep)) < nbil) | pushing))[0]
+            rows = np.concatenate((equal, inequal))
+            n_equal = len(equal)
             values = violation[rows]
             equal_error = np.max(np.abs(values[:n_equal])) if n_equal else 0.0
             unilateral_error = max(0.0, -np.min(values[n_equal:])) if len(values) > n_equal \
@@ -396,12 +521,10 @@ class MoreauJeanStepper:
                 break
             rb = np.ascontiguousarray(row_body[rows])
             rc = np.ascontiguousarray(row_coef[rows])
-            w, y = delassus(rb, rc, len(rows), self.inverse_mass, *self.single_clusters)
-            # Contacts already separated enough need no correction; keep them in the MLCP (their
-            # multiplier is zero) so that the set stays the active set of the step.
-            mlcp = solve_mlcp(w, values, n_equal, tolerance=1e-14,
-                              max_iterations=1000)
-            delta = (y @ mlcp.z).reshape(-1, 6)
+            w, y = delassus(rb, rc, len(rows), self.projection_inverse, *self.single_clusters)
+            # Contacts of the active set that are open keep a zero multiplier.
+            solve = solve_projection(w, values, n_equal, 0.1 * cfg.position_tolerance)
+            delta = (y @ solve.delta).reshape(-1, 6)
             state.x += delta[:, :3]
             for b in range(sys_.body_count):
                 if not sys_.body_fixed[b]:
@@ -418,4 +541,3 @@ class _NoSolve:
 
 
 _NO_SOLVE = _NoSolve()
-_CLOCK = time.perf_counter

@@ -85,6 +85,7 @@ class MultibodySystem:
     driver_times: np.ndarray         # (sum,)           [T]
     driver_values: np.ndarray        # (sum,)           [L, L/T, rad or rad/T]
     driver_initial: np.ndarray       # (nd,)            initial value of the component
+    driver_reference: np.ndarray     # (nd, 4)          body orientation at t = 0
     # force elements: kind, two bodies (-1 = none), real parameters (see forces.py)
     force_kind: np.ndarray           # (nf,) int
     force_body_a: np.ndarray         # (nf,) int

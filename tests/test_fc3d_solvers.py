@@ -151,3 +151,24 @@ def test_mlcp_cap_and_warm_start():
     solved = solve_mlcp(A, b, ne, tolerance=1e-10, max_iterations=20000)
     warm = solve_mlcp(A, b, ne, tolerance=1e-10, z0=solved.z)
     assert warm.converged and warm.iterations == 1
+
+
+def test_frictionless_take_off_has_zero_residual():
+    # mu = 0: the cone is the ray r_T = 0, r_N >= 0. A separating contact (q_N > 0) has the
+    # solution r = 0, u = q, whose natural-map residual is exactly 0 (it was reported as 1
+    # when (-q_N, 0, 0) was wrongly taken for a point of the degenerate cone).
+    from clearbench.ref_solver import (
+        ContactProblem,
+        SolverOptions,
+        natural_map_residual,
+        solve_contact_problem,
+    )
+
+    W = np.diag([1.0, 3.5, 3.5])
+    q = np.array([0.5, 0.0, 0.0])
+    mu = np.array([0.0])
+    assert natural_map_residual(W, q, mu, np.zeros(3)) == 0.0
+    for method in ("nsgs", "newton"):
+        result = solve_contact_problem(ContactProblem(W, q, mu), SolverOptions(method=method))
+        assert result.converged
+        assert np.array_equal(result.r, np.zeros(3))

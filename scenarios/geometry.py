@@ -1,0 +1,376 @@
+"""Contact geometry shared by the reference solver, every engine adapter and the metrics.
+
+Pure functions on shape kinds, packed parameters and world placements: no scene dataclass is
+needed by the compiled kernels, so ``ref_solver`` may import this module.
+
+Conventions (kept exactly by every pair)
+----------------------------------------
+- For a pair (shape A on body A, shape B on body B), the normal ``n`` is the unit vector
+  pointing FROM A TOWARD B. ``p_A`` is the contact point on A's surface, ``p_B`` on B's surface
+  (world coordinates), and the signed gap is ``g = (p_B - p_A) . n``: ``g > 0`` separated,
+  ``g = 0`` touching, ``g < 0`` penetrating (then ``-g`` is the penetration depth). Every kernel
+  returns ``p_B - p_A = g n`` (to round-off).
+- Where ``p_B`` is the closest point of B to a material point of A (or the reverse), the gap
+  is a signed distance whose gradient with respect to a translation of B is ``n`` and with
+  respect to a translation of A is ``-n``. This holds for every pair except box-box points
+  created by clipping (see below).
+- Swapping A and B gives the same gaps, swapped points and the opposite normals (exactly: the
+  kernels run one canonical order and mirror it; same-kind pairs pick their order from the
+  data, not from the argument order).
+- Contact frame: rows ``(n, t1, t2)``, right-handed orthonormal (``t1 x t2 = n``), a function
+  of ``n`` alone (:func:`contact_frame`). It is smooth everywhere except at the single normal
+  direction :data:`FRAME_SINGULAR_DIRECTION` = -(2, 3, 6)/7, where it is still defined and
+  orthonormal (see :mod:`clearbench.scenarios.geometry_frames`).
+- Offsets: the scene's contact offset is NOT applied here; callers subtract it from the gap.
+- Candidates: pairs with several candidate points (box corners, cylinder rims) return all of
+  them with their gaps, including separated ones; the caller keeps those below its activation
+  threshold.
+- Units: lengths in the scene's unit, angles in rad, everything float64.
+
+Pairs (both orders of each are supported; K = number of candidates returned)
+---------------------------------------------------------------------------
+================  ===  ==========================================================================
+sphere-plane       1   centre height minus radius.
+sphere-sphere      1   centre distance minus radii (concentric: n = +z).
+sphere-box         1   closest point of the solid box; centre inside: nearest face.
+sphere-capsule     1   closest point of the axis segment.
+sphere-cylinder    1   closest point of the SOLID finite cylinder (lateral surface and flat ends).
+box-plane          8   every corner with its height above the plane.
+box-box           1-8  separating-axis test over the 6 face axes and 9 edge-edge axes picks the
+                       contact feature (faces preferred on near-ties). Face: the incident face of
+                       the other box (most opposed to the reference face normal) is clipped
+                       against the reference face rectangle (Sutherland-Hodgman); each clipped
+                       vertex is a candidate with its depth along the reference normal. Edge-edge:
+                       one contact at the closest points of the two supporting edges (separated:
+                       their distance; penetrating: the depth along the axis). Limits:
+                       clipped (non-corner) points are not closest points, so their gap
+                       derivative is not exactly the normal when the faces are not parallel; a
+                       face whose rectangle does not overlap the incident face's projection gives
+                       0 candidates (boxes side by side diagonally); deep penetrations (more than
+                       about half a box) can pick a wrong feature. Good for resting stacks,
+                       sliding and tipping boxes; not a general polyhedron test.
+capsule-plane      2   the two end spheres.
+capsule-capsule   1-2  closest points of the axes; exactly parallel axes (|a x b| < 1e-6): the two
+                       ends of the overlap (a line contact needs two points).
+cylinder-plane     8   on each end rim: the lowest point and the points 90, 180, 270 degrees round
+                       (indices 0 and 1 are the two lowest rim points, the support of a lying
+                       cylinder; a standing cylinder gets 4 points on its bottom rim). The lowest
+                       point of the solid is always one of indices 0, 1. Rim parallel to the
+                       plane: the rim points start from the cylinder's own x axis.
+circle-plane       1   lowest point of the circle along -n (closed form). Circle parallel to the
+                       plane: the point at angle 0 (the circle's x axis).
+arc-plane          1   lowest point of the circle if its angle lies in the arc, else the lower arc
+                       end. Arc parallel to the plane: its middle point.
+circle-cylinder    1   bearing ring against a journal, or ring against a pin (below).
+arc-cylinder       1   the same, restricted to the arc's angles (else the better arc end).
+================  ===  ==========================================================================
+
+Ring (circle or arc) against cylinder. The cylinder is the journal: its lateral surface is
+taken as INFINITELY LONG (the half_length is ignored; axial motion is limited by the flange
+contacts of the clearance joint, and ``point_b`` may lie beyond the journal's ends). The gap is
+the signed distance from the ring point nearest the cylinder axis to the lateral surface:
+``g = min_theta dist(c(theta), axis) - R_cyl``, with ``n`` perpendicular to the axis, from the
+ring point toward the axis. The one formula covers both cases:
+
+- INTERNAL (the axis passes inside the ring: a journal in the bore). With parallel axes at
+  eccentricity ``e``: ``g = R_ring - R_cyl - e`` exactly (the radial clearance minus the
+  eccentricity); the contact is on the side toward which the journal is displaced.
+- EXTERNAL (the axis outside the ring: a ring against a pin): ``g = e - R_ring - R_cyl`` for
+  parallel axes.
+
+Tilted axes (3D, any tilt; accurate to round-off, tested against dense sampling up to 10
+degrees and beyond): the squared axis distance of the ring point is a trigonometric polynomial
+of degree 2 in the ring angle. The parallel-axis closed form (the angle of the projected
+eccentricity) is polished by bracketed Newton steps whenever the tilt term is small against the
+eccentricity term (then the minimum is unique and the function convex around it); otherwise
+(small eccentricity, large tilt: two minima possible) all stationary angles are found from a
+quartic and the best one kept. The gap is meaningful for penetrations smaller than the journal
+radius.
+
+Python side
+-----------
+:func:`contacts_between` takes ``scenarios.shapes`` objects and body poses and returns a
+:class:`PairContacts`. :func:`pack_shape_parameters`, :func:`shape_code` and
+:func:`supported_pair` / :func:`check_supported_pair` prepare calls of the compiled
+:func:`pair_contacts` from other compiled code.
+
+Compiled callers
+----------------
+``pair_contacts(kind_a, params_a, position_a, rotation_a, kind_b, params_b, position_b,
+rotation_b, out_gap, out_point_a, out_point_b, out_frame) -> count`` is ``njit(inline=
+"always")`` (a thin wrapper that turns its inputs into tuples, so the kernels below it run
+without reference counting). Outputs have K >= MAX_CONTACTS_PER_PAIR rows; ``out_point_a`` and
+``out_point_b`` are also used as work space, so pass distinct arrays. Rotations must be
+orthonormal to round-off (as :func:`quat_to_matrix` gives). An unsupported pair raises
+ValueError inside compiled code too; check :func:`supported_pair` when building the pair list.
+numba's on-disk cache does not notice edits in modules a cached function calls: after editing
+these kernels, clear the ``__pycache__`` numba files (``*.nbi``, ``*.nbc``) of the callers.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .geometry_frames import (
+    FRAME_POLE,
+    FRAME_SINGULAR_DIRECTION,
+    contact_frame,
+    contact_frames_batch,
+    frame_tangent,
+    write_contact_frame,
+)
+from .geometry_pairs import (
+    ARC,
+    BOX,
+    CAPSULE,
+    CIRCLE,
+    CYLINDER,
+    MAX_CONTACTS_PER_PAIR,
+    PARAMETER_COUNT,
+    PLANE,
+    SHAPE_KIND_NAMES,
+    SPHERE,
+    SUPPORTED,
+    pair_contacts,
+)
+from .quaternion import quat_multiply, quat_normalize, quat_to_matrix
+
+if TYPE_CHECKING:  # the kernels and this module never need the scene dataclasses at run time
+    from .shapes import Shape
+
+__all__ = [
+    "ARC",
+    "BOX",
+    "CAPSULE",
+    "CIRCLE",
+    "CYLINDER",
+    "FRAME_POLE",
+    "FRAME_SINGULAR_DIRECTION",
+    "MAX_CONTACTS_PER_PAIR",
+    "PARAMETER_COUNT",
+    "PLANE",
+    "SHAPE_CODES",
+    "SPHERE",
+    "PairContacts",
+    "UnsupportedPairError",
+    "check_supported_pair",
+    "contact_frame",
+    "contact_frames_batch",
+    "contacts_between",
+    "frame_tangent",
+    "kind_name",
+    "pack_shape_parameters",
+    "pair_contacts",
+    "shape_code",
+    "shape_world_placement",
+    "supported_pair",
+    "write_contact_frame",
+]
+
+#: Shape code of every ``Shape.kind`` string.
+SHAPE_CODES: dict[str, int] = {name: code for code, name in enumerate(SHAPE_KIND_NAMES)}
+
+
+#: Fields of each shape kind, in packed order (see :func:`pack_shape_parameters`).
+_PACKED_FIELDS: dict[str, tuple[str, ...]] = {
+    "sphere": ("radius",),
+    "box": ("half_extents",),
+    "capsule": ("radius", "half_length"),
+    "cylinder": ("radius", "half_length"),
+    "plane": (),
+    "circle": ("radius",),
+    "arc": ("radius", "start_angle", "end_angle"),
+}
+
+
+class UnsupportedPairError(ValueError):
+    """No contact kernel exists for this pair of shape kinds."""
+
+    def __init__(self, kind_a: str, kind_b: str):
+        self.kind_a = kind_a
+        self.kind_b = kind_b
+        supported = ", ".join(
+            f"{SHAPE_KIND_NAMES[a]}-{SHAPE_KIND_NAMES[b]}"
+            for a in range(len(SHAPE_KIND_NAMES))
+            for b in range(a, len(SHAPE_KIND_NAMES))
+            if SUPPORTED[a, b]
+        )
+        super().__init__(
+            f"no contact geometry for the pair {kind_a}-{kind_b} (shape A is a {kind_a}, "
+            f"shape B is a {kind_b}); supported pairs, in either order: {supported}"
+        )
+
+
+def _code(kind: int | str | Shape) -> int:
+    if not isinstance(kind, str | int | np.integer):
+        kind = kind.kind  # a scenarios.shapes object
+    if isinstance(kind, str):
+        if kind not in SHAPE_CODES:
+            raise ValueError(f"unknown shape kind {kind!r}; known: {', '.join(SHAPE_CODES)}")
+        return SHAPE_CODES[kind]
+    code = int(kind)
+    if not 0 <= code < len(SHAPE_KIND_NAMES):
+        raise ValueError(f"unknown shape code {kind!r}; codes are 0..{len(SHAPE_KIND_NAMES) - 1}")
+    return code
+
+
+def shape_code(shape: int | str | Shape) -> int:
+    """Shape code (SPHERE, BOX, ...) of a shape object, a kind string or a code."""
+    return _code(shape)
+
+
+def kind_name(shape: int | str | Shape) -> str:
+    """Kind string ('sphere', 'box', ...) of a shape object, a kind string or a code."""
+    return SHAPE_KIND_NAMES[_code(shape)]
+
+
+def supported_pair(kind_a: int | str | Shape, kind_b: int | str | Shape) -> bool:
+    """True if :func:`pair_contacts` handles shape A of ``kind_a`` against B of ``kind_b``."""
+    return bool(SUPPORTED[_code(kind_a), _code(kind_b)])
+
+
+def check_supported_pair(kind_a: int | str | Shape, kind_b: int | str | Shape) -> None:
+    """Raise :class:`UnsupportedPairError` (a ValueError naming both kinds) if unsupported."""
+    if not supported_pair(kind_a, kind_b):
+        raise UnsupportedPairError(kind_name(kind_a), kind_name(kind_b))
+
+
+def pack_shape_parameters(shape: Shape) -> np.ndarray:
+    """Parameters of ``shape`` as the (PARAMETER_COUNT,) float64 vector the kernels read.
+
+    ========  ============================================
+    sphere    [radius]
+    box       [half_x, half_y, half_z]
+    capsule   [radius, half_length]
+    cylinder  [radius, half_length]
+    plane     []
+    circle    [radius]
+    arc       [radius, start_angle, end_angle] (rad)
+    ========  ============================================
+
+    Unused entries are 0. Lengths in the scene's unit.
+    """
+    kind = getattr(shape, "kind", None)
+    if kind not in _PACKED_FIELDS:
+        raise ValueError(f"no packed form for shape {shape!r} of kind {kind!r}")
+    values: list[float] = []
+    for name in _PACKED_FIELDS[kind]:
+        value = getattr(shape, name)
+        values.extend(value if isinstance(value, tuple | list) else (value,))
+    packed = np.zeros(PARAMETER_COUNT)
+    packed[: len(values)] = values
+    return packed
+
+
+def shape_world_placement(
+    shape: Shape, body_position, body_quaternion
+) -> tuple[np.ndarray, np.ndarray]:
+    """World placement of a shape's own frame from its body's pose.
+
+    Parameters
+    ----------
+    shape : Shape
+        Shape with its placement (``position``, ``orientation``) in the body frame.
+    body_position : array_like (3,)
+        World position of the body frame origin (length).
+    body_quaternion : array_like (4,)
+        World orientation of the body frame, unit quaternion (w, x, y, z).
+
+    Returns
+    -------
+    position : ndarray (3,)
+        World position of the shape frame origin.
+    rotation : ndarray (3, 3)
+        World rotation of the shape frame (columns = shape axes in world).
+    """
+    body_position = np.asarray(body_position, dtype=np.float64)
+    body_quaternion = quat_normalize(np.asarray(body_quaternion, dtype=np.float64))
+    body_rotation = quat_to_matrix(body_quaternion)
+    position = body_position + body_rotation @ np.asarray(shape.position, dtype=np.float64)
+    orientation = quat_normalize(
+        quat_multiply(body_quaternion, np.asarray(shape.orientation, dtype=np.float64))
+    )
+    return position, quat_to_matrix(orientation)
+
+
+@dataclass(frozen=True)
+class PairContacts:
+    """Candidate contacts of one pair (k of them, 0 <= k <= MAX_CONTACTS_PER_PAIR).
+
+    Attributes
+    ----------
+    gap : ndarray (k,)
+        Signed gaps (length), before any contact offset.
+    point_a, point_b : ndarray (k, 3)
+        Contact points on A's and on B's surface, world coordinates.
+    frame : ndarray (k, 3, 3)
+        Contact frames, rows (n, t1, t2); n points from A toward B.
+    """
+
+    gap: np.ndarray
+    point_a: np.ndarray
+    point_b: np.ndarray
+    frame: np.ndarray
+
+    @property
+    def normal(self) -> np.ndarray:
+        """Normals (k, 3), from A toward B."""
+        return self.frame[:, 0, :]
+
+    @property
+    def count(self) -> int:
+        return int(self.gap.shape[0])
+
+    def __len__(self) -> int:
+        return self.count
+
+
+def contacts_between(shape_a: Shape, pose_a, shape_b: Shape, pose_b) -> PairContacts:
+    """Candidate contacts between two shapes on posed bodies.
+
+    Parameters
+    ----------
+    shape_a, shape_b : Shape
+        ``scenarios.shapes`` objects, placed in their bodies' frames.
+    pose_a, pose_b : tuple (position (3,), quaternion (4,))
+        World pose of each BODY frame (length; unit quaternion w, x, y, z).
+
+    Returns
+    -------
+    PairContacts
+        Read-only arrays (k,), (k, 3), (k, 3, 3).
+
+    Raises
+    ------
+    UnsupportedPairError
+        If no kernel handles the two kinds (a ValueError naming both).
+    """
+    check_supported_pair(shape_a, shape_b)
+    position_a, rotation_a = shape_world_placement(shape_a, *pose_a)
+    position_b, rotation_b = shape_world_placement(shape_b, *pose_b)
+    gap = np.empty(MAX_CONTACTS_PER_PAIR)
+    point_a = np.empty((MAX_CONTACTS_PER_PAIR, 3))
+    point_b = np.empty((MAX_CONTACTS_PER_PAIR, 3))
+    frame = np.empty((MAX_CONTACTS_PER_PAIR, 3, 3))
+    count = pair_contacts(
+        shape_code(shape_a),
+        pack_shape_parameters(shape_a),
+        position_a,
+        rotation_a,
+        shape_code(shape_b),
+        pack_shape_parameters(shape_b),
+        position_b,
+        rotation_b,
+        gap,
+        point_a,
+        point_b,
+        frame,
+    )
+    arrays = [gap[:count].copy(), point_a[:count].copy(), point_b[:count].copy()]
+    arrays.append(frame[:count].copy())
+    for array in arrays:
+        array.setflags(write=False)
+    return PairContacts(*arrays)
