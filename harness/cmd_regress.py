@@ -32,7 +32,10 @@ def register(subparsers) -> None:
                         help=f"baseline file (default {DEFAULT_BASELINE})")
     parser.add_argument("--update", action="store_true",
                         help="rewrite the baseline's results from this run")
-    parser.add_argument("--jobs", "-j", type=int, default=None, help="parallel workers")
+    parser.add_argument("--jobs", "-j", type=int, default=None,
+                        help="parallel workers (default: usable cores)")
+    parser.add_argument("--runs-per-worker", type=int, default=1, metavar="N",
+                        help="runs a worker serves before it is replaced (default 1)")
     parser.add_argument("--engine-module", action="append", default=[], metavar="NAME=MODULE",
                         help="an extra engine adapter module, e.g. mine=my_package.adapter")
     parser.set_defaults(handler=run_regress)
@@ -47,7 +50,9 @@ def run_regress(args: argparse.Namespace) -> int:
         raise UserError(f"{args.baseline}: {error}") from None
     except ValueError as error:
         raise UserError(f"{args.baseline}: not a baseline file: {error}") from None
-    results = run_suite(specs, jobs=args.jobs)
+    if args.runs_per_worker < 1 or (args.jobs is not None and args.jobs < 1):
+        raise UserError("--jobs and --runs-per-worker must be >= 1")
+    results = run_suite(specs, jobs=args.jobs, runs_per_worker=args.runs_per_worker)
     elapsed = time.monotonic() - start
     if args.update:
         write_baseline(args.baseline, updated_baseline(baseline, results))

@@ -130,12 +130,13 @@ def _result_of(row: dict) -> dict:
 
 
 def run_suite(specs: dict[str, RunSpec], store_dir: str | Path | None = None,
-              jobs: int | None = None, progress: bool = False) -> dict[str, dict]:
+              jobs: int | None = None, runs_per_worker: int = 1,
+              progress: bool = False) -> dict[str, dict]:
     """Run the suite (in a temporary store unless one is given) and return results by id."""
     with tempfile.TemporaryDirectory(prefix="clearbench-regress-") as scratch:
         store = ResultsStore(store_dir or scratch)
-        Runner(store, jobs=jobs, progress=progress).run_all(list(specs.values()),
-                                                            rerun=store_dir is None)
+        Runner(store, jobs=jobs, runs_per_worker=runs_per_worker,
+               progress=progress).run_all(list(specs.values()), rerun=store_dir is None)
         return {ident: _result_of(store.get(spec.key)) for ident, spec in specs.items()}
 
 
@@ -162,7 +163,7 @@ def compare(baseline: dict, results: dict[str, dict]) -> RegressOutcome:
                 continue
             value = float(new["metrics"][metric])
             outcome.compared_figures += 1
-            base_number = float("nan") if base_value is None else float(base_value)
+            base_number = _decode(base_value)
             if not tolerance.allows(base_number, value):
                 outcome.regressions.append(
                     f"{ident}: {metric} {base_number:.6g} -> {value:.6g} (tolerance "
@@ -175,11 +176,25 @@ def compare(baseline: dict, results: dict[str, dict]) -> RegressOutcome:
     return outcome
 
 
+def _encode(value):
+    """Plain JSON for a figure: non-finite numbers as the strings 'nan', 'inf', '-inf'."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return str(value)
+    return value
+
+
+def _decode(value) -> float:
+    return float("nan") if value is None else float(value)
+
+
 def updated_baseline(baseline: dict, results: dict[str, dict]) -> dict:
     """The baseline with ``results`` and ``recorded`` replaced."""
     new = dict(baseline)
-    new["results"] = {ident: {k: v for k, v in result.items() if k != "message"}
-                      for ident, result in results.items()}
+    new["results"] = {
+        ident: {"status": result["status"],
+                "expectations_passed": result["expectations_passed"],
+                "metrics": {k: _encode(v) for k, v in sorted(result["metrics"].items())}}
+        for ident, result in results.items()}
     revision = revision_info()
     machine = machine_info()
     new["recorded"] = {"revision": revision["revision"], "dirty": revision["dirty"],
@@ -191,4 +206,4 @@ def updated_baseline(baseline: dict, results: dict[str, dict]) -> dict:
 def write_baseline(path: str | Path, baseline: dict) -> None:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(baseline, indent=2, sort_keys=False) + "\n")
+    path.write_text(json.dumps(baseline, indent=2, sort_keys=False, allow_nan=False) + "\n")

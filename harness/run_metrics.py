@@ -20,8 +20,10 @@ in the scene's units (named below); a figure that does not apply to the scene is
 ``energy_growth``                        max rise of E above its running minimum / scale [-]
 ``output_error.NAME``                    max |y - y_ref| on named output NAME [its unit]
 ``error``                                headline error (relative): analytic where the scene
-                                         has an analytic reference, else the largest relative
-                                         output error against the reference trajectory [-]
+                                         has an analytic reference (see judgement.py), else the
+                                         largest relative output error against the reference
+                                         trajectory [-]
+``EXPECTATION.FIGURE``                   every figure of every expectation (expectations.py)
 ``solver_unconverged_steps``             recorded steps whose one-step problem did not converge
 ``solver_residual_max``                  largest recorded residual (engine's measure) [-]
 ``solver_iterations_mean``               mean recorded iterations
@@ -36,7 +38,6 @@ pair (tunnelling); ``ok`` otherwise.
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 import math
 from dataclasses import dataclass
@@ -55,11 +56,6 @@ ENERGY_GROWTH_LIMIT = 0.1
 ESCAPE_FACTOR = 100.0
 #: A clearance-joint excess beyond this many radial clearances means the journal left its bore.
 BORE_ESCAPE_FACTOR = 10.0
-#: Expectation kinds with an analytic solution (their ``error`` figure is the run's error).
-ANALYTIC_KINDS = frozenset({
-    "bounce_apex", "incline_slide", "sliding_stop", "rolling_transition", "pendulum",
-    "torque_free", "slider_crank", "rocking_ratio",
-})
 #: Expectation kinds whose body must not move.
 STICK_KINDS = frozenset({"incline_stick", "sticks"})
 #: Features whose loads do work the energy balance does not count.
@@ -80,7 +76,9 @@ class Measurement:
 
 def has_analytic_reference(scene: Scene) -> bool:
     """True when an expectation of the scene has an analytic solution to measure error by."""
-    return any(e.kind in ANALYTIC_KINDS for e in scene.expectations)
+    from .judgement import ANALYTIC_ERROR
+
+    return any(e.kind in ANALYTIC_ERROR for e in scene.expectations)
 
 
 def first_non_finite(trajectory: Trajectory) -> str | None:
@@ -127,34 +125,30 @@ def scene_size(scene: Scene) -> float:
     return size if size > 0 else 1.0
 
 
-def _analytic_error(results: list[dict]) -> tuple[float, str]:
-    errors = [(float(r["figures"]["error"]), r.get("name", r.get("kind", "")))
-              for r in results
-              if r.get("kind") in ANALYTIC_KINDS and "error" in (r.get("figures") or {})
-              and r["figures"]["error"] is not None and math.isfinite(r["figures"]["error"])]
+def _expectation_results(scene: Scene, trajectory: Trajectory, out: _Collector):
+    """Every expectation's figures (also flattened into ``NAME.FIGURE`` figures), pass/fail
+    and criterion (:mod:`.judgement`), and the analytic error with its source."""
+    from .expectations import evaluate
+    from .judgement import analytic_error, judge
+
+    bodies = {e.name: e.body for e in scene.expectations}
+    results = []
+    errors = []
+    for result in evaluate(scene, trajectory):
+        figures = {k: float(v) for k, v in result.figures.items()}
+        passed, criterion = judge(scene, result.kind, bodies.get(result.name), figures)
+        results.append({"name": result.name, "kind": result.kind, "figures": figures,
+                        "headline": result.headline, "note": result.note, "passed": passed,
+                        "criterion": criterion})
+        for key, value in figures.items():
+            out.put(f"{result.name}.{key}", value)
+        error = analytic_error(result.kind, figures)
+        if math.isfinite(error):
+            errors.append((error, result.name))
     if not errors:
-        return math.nan, ""
+        return results, math.nan, ""
     value, name = max(errors)
-    return value, f"analytic ({name})"
-
-
-def _as_plain(value):
-    """Plain JSON-able form of an expectation result (dataclass, mapping or object)."""
-    if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        value = {f.name: getattr(value, f.name) for f in dataclasses.fields(value)}
-    elif hasattr(value, "_asdict"):
-        value = value._asdict()
-    if isinstance(value, dict):
-        return {str(k): _as_plain(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_as_plain(v) for v in value]
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if hasattr(value, "value") and isinstance(value.value, str):  # enums
-        return value.value
-    return value
+    return results, value, f"analytic ({name})"
 
 
 class _Collector:
@@ -229,11 +223,9 @@ def measure(scene: Scene, trajectory: Trajectory, reference: Trajectory | None =
         _escape(scene, trajectory, metrics, reasons)
 
     results: list[dict] = []
+    error, source = math.nan, ""
     with out.guard("expectations"):
-        from .expectations import evaluate
-
-        results = [_as_plain(r) for r in evaluate(scene, trajectory)]
-    error, source = _analytic_error(results)
+        results, error, source = _expectation_results(scene, trajectory, out)
     if math.isnan(error) and reference is not None and scene.outputs:
         with out.guard("reference error"):
             error = _output_error(scene, trajectory, reference, metrics, out)

@@ -11,7 +11,8 @@ Presets misbehave on purpose:
 - ``raise``: raises RuntimeError;
 - ``energy``: velocities grow 1 % per step, status OK (energy growth must be caught).
 
-Options: ``sleep`` (seconds to sleep before running), ``bias`` (added to every z [L]). The
+Options: ``sleep`` (seconds to sleep before running), ``bias`` (every recorded z drifts up at
+this rate [L/T], velocities untouched: a position error that grows with time). The
 environment variable ``CLEARBENCH_FAKE_BIAS`` adds to ``bias`` (to inject a regression without
 touching a suite definition), and ``CLEARBENCH_FAKE_NAN`` (non-empty) makes every preset behave
 as ``nan``. Clearance joints are reported unsupported.
@@ -117,7 +118,7 @@ class FakeEngine(Engine):
                     q[b] = _quat_multiply(q[b], _quat_exp(h * w[b]))
             if slot < count and k == record[slot]:
                 out["positions"][slot] = x
-                out["positions"][slot, :, 2] += bias
+                out["positions"][slot, :, 2] += bias * k * h
                 out["orientations"][slot] = q
                 out["velocities"][slot] = v
                 out["angular_velocities"][slot] = w
