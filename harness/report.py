@@ -99,7 +99,7 @@ def collect(store: ResultsStore, figures: bool = True) -> ReportData:
 
 def _figures(store: ResultsStore, section: SceneSection) -> None:
     points = work_precision_points(section.runs, section.name)
-    if len(points) >= 2:
+    if np.count_nonzero(points["error"] > 0) >= 2:
         section.figures["Work–precision"] = work_precision_figure(
             points, f"{section.name}: error against stepping time")
     if section.scene is None:

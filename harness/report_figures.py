@@ -46,20 +46,26 @@ def work_precision_figure(points, title: str) -> bytes:
     """``points``: DataFrame from :func:`.sweep.work_precision_points`."""
     plt = _pyplot()
     figure, axes = plt.subplots(figsize=(6.4, 4.2))
+    exact = points[points["error"] <= 0]
+    points = points[points["error"] > 0]  # an exact result has no place on a log scale
     for label, rows in points.groupby("label", sort=True):
         rows = rows.sort_values("stepping_seconds_per_simulated_second")
         x = rows["stepping_seconds_per_simulated_second"].to_numpy(dtype=float)
-        y = np.maximum(rows["error"].to_numpy(dtype=float), 1e-300)
+        y = rows["error"].to_numpy(dtype=float)
         (line,) = axes.loglog(x, y, "o-", label=label)
         for xi, yi, dt in zip(x, y, rows["time_step"], strict=True):
             axes.annotate(f"{dt:.2g}", (xi, yi), textcoords="offset points", xytext=(4, 3),
                           fontsize=7, color=line.get_color())
     front = points[points["pareto"].astype(bool)]
     if len(front):
-        axes.loglog(front["stepping_seconds_per_simulated_second"],
-                    np.maximum(front["error"].to_numpy(dtype=float), 1e-300), "o",
+        axes.loglog(front["stepping_seconds_per_simulated_second"], front["error"], "o",
                     markersize=12, markerfacecolor="none", markeredgecolor="black",
                     label="Pareto front")
+    if len(exact):
+        axes.text(0.02, 0.02, "error 0 (not drawn): " + ", ".join(
+            f"{label} dt={dt:.2g}" for label, dt in zip(exact["label"], exact["time_step"],
+                                                        strict=True)),
+            transform=axes.transAxes, fontsize=7)
     axes.set_xlabel("stepping wall time per simulated time unit [s]")
     axes.set_ylabel("error (relative)")
     axes.set_title(title, fontsize=10)

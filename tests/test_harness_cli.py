@@ -85,3 +85,32 @@ def test_error_against_the_fine_reference_falls_with_the_step(tmp_path):
     # Symplectic Euler is first order: halving dt roughly halves the error (1.3 to 3 allows
     # for the fine reference's own O(dt/16) error).
     assert all(1.3 < errors[i + 1] / errors[i] < 3.0 for i in range(len(errors) - 1))
+
+
+def test_compare_runs_and_writes_the_report(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["compare", "-e", "fake", "--scenes", "torque-free-flip", "pendulum",
+                 "--dt", "1x", "--store", str(tmp_path / "store"), "--out", str(out),
+                 *FAKE_OPTION]) == 0
+    text = capsys.readouterr().out
+    assert "2 runs done" in text and "report:" in text
+    assert (out / "report.html").exists() and (out / "summary.md").exists()
+
+
+def test_stability_runs_every_stiff_case(tmp_path, capsys):
+    from clearbench.scenarios.registry import scene_names
+
+    assert main(["stability", "-e", "fake", "--store", str(tmp_path / "store"),
+                 *FAKE_OPTION]) == 0
+    text = capsys.readouterr().out
+    for name in scene_names("stiff"):
+        assert name in text
+    assert "unsupported" in text  # the fake engine has no clearance joints
+
+
+@pytest.mark.slow
+def test_demo_is_the_default_comparison(tmp_path, capsys):
+    """The README's main job end to end on the engines available here (minutes)."""
+    out = tmp_path / "out"
+    assert main(["demo", "--store", str(tmp_path / "store"), "--out", str(out)]) == 0
+    assert (out / "report.html").exists()
