@@ -11,7 +11,8 @@ Presets (each a separate engine variant in results):
 
 Options (``RunSettings.options``) override: ``theta``, ``projection``, ``method``,
 ``tolerance``, ``max_iterations``, ``position_tolerance``, ``restitution_threshold`` (default
-2 |g| h: slower impacts are plastic, see :class:`StepperSettings`).
+2 |g| h: slower impacts are plastic), ``joint_law`` (``midpoint`` or ``end``); see
+:class:`~clearbench.ref_solver.stepper.StepperSettings`.
 """
 
 from __future__ import annotations
@@ -38,7 +39,7 @@ PRESETS: dict[str, dict] = {
     "implicit": {"theta": 1.0, "projection": True, "method": "hybrid"},
 }
 OPTION_NAMES = ("theta", "projection", "method", "tolerance", "max_iterations",
-                "position_tolerance", "restitution_threshold")
+                "position_tolerance", "restitution_threshold", "joint_law")
 
 
 def availability() -> tuple[bool, str]:
@@ -101,6 +102,7 @@ class ReferenceEngine(Engine):
             activation_margin=1e-10 * smallest,
             length_scale=largest,
             method=method,
+            joint_law=str(options.get("joint_law", "midpoint")),
             # Bounces slower than two steps' worth of gravity cannot be resolved by the fixed
             # step; they are taken as plastic so that bodies come to rest (see StepperSettings).
             restitution_threshold=float(options.get(

@@ -23,6 +23,7 @@ COMMAND_MODULES: tuple[str, ...] = (
     "clearbench.harness.cmd_regress",
     "clearbench.harness.cmd_c60_extract",
     "clearbench.harness.cmd_fclib",
+    "clearbench.harness.cmd_bench",
 )
 
 
