@@ -123,7 +123,7 @@ def tolerance_for(baseline: dict, metric: str) -> Tolerance:
 
 def _result_of(row: dict) -> dict:
     passed = row["expectations_passed"]
-    return {"status": row["status"],
+    return {"status": row["status"], "scene_hash": row["scene_hash"],
             "expectations_passed": None if passed is None else int(passed),
             "metrics": json.loads(row["metrics"] or "{}"),
             "message": row["message"]}
@@ -149,6 +149,10 @@ def compare(baseline: dict, results: dict[str, dict]) -> RegressOutcome:
         if base is None:
             outcome.regressions.append(f"{ident}: no baseline result (run with --update)")
             continue
+        if base.get("scene_hash") and new.get("scene_hash") != base["scene_hash"]:
+            outcome.notes.append(f"{ident}: the scene definition changed since the baseline "
+                                 f"({base['scene_hash'][:12]} -> {new['scene_hash'][:12]}): "
+                                 "differences may come from the scene, not the solver")
         if new["status"] != base["status"]:
             outcome.regressions.append(f"{ident}: status {base['status']} -> {new['status']}"
                                        + (f" ({new['message']})" if new["message"] else ""))
@@ -191,7 +195,7 @@ def updated_baseline(baseline: dict, results: dict[str, dict]) -> dict:
     """The baseline with ``results`` and ``recorded`` replaced."""
     new = dict(baseline)
     new["results"] = {
-        ident: {"status": result["status"],
+        ident: {"status": result["status"], "scene_hash": result["scene_hash"],
                 "expectations_passed": result["expectations_passed"],
                 "metrics": {k: _encode(v) for k, v in sorted(result["metrics"].items())}}
         for ident, result in results.items()}

@@ -22,6 +22,7 @@ from .outputs import PointPosition
 from .registry import register
 from .scene import Scene
 from .shapes import Box
+from .units import UnitSystem
 
 STIFF_TAG = "stiff"
 
@@ -182,12 +183,17 @@ def many_contacts(count: int = 36) -> Scene:
 
 
 @register("stiff-millimetre-parts", tags=(STIFF_TAG, "clearance"),
-          summary="gram-scale clearance pendulum with millimetre parts, in SI units")
+          summary="the clearance pendulum shrunk to a 1 cm, 1 g rod with micrometre clearances, "
+          "in SI units")
 def millimetre_parts() -> Scene:
-    """The clearance pendulum shrunk to a 1 g bob on a 10 mm arm, journal radius 0.5 mm,
-    clearances 10 um, still in metres and kilograms: tolerances must be relative."""
-    scene = clearance_pendulum(length=0.01, mass=1e-3, bob_radius=2e-3, journal_radius=5e-4,
-                               radial_clearance=1e-5, axial_clearance=1e-5, bearing_length=1e-3)
-    return _renamed(scene, "stiff-millimetre-parts",
-                    "The clearance pendulum with a 1 g bob on a 10 mm arm, journal radius 0.5 "
-                    "mm and 10 um clearances, in SI units.", horizon=0.5, time_step=1e-4)
+    """The clearance pendulum with every length x 1e-2 and every mass x 1e-3 (a 1 cm rod of
+    1 g, journal radius 0.1 mm, clearances 1 um), still in metres and kilograms, so that
+    tolerances must be relative to work. Built by reading the SI scene's numbers as
+    centimetres and grams (gravity set to 981 cm/s^2) and converting back to SI."""
+    scene = clearance_pendulum()
+    small = dataclasses.replace(scene, units=UnitSystem("cm", "g", "s"),
+                                gravity=tuple(100.0 * g for g in scene.gravity))
+    shrunk = small.rescaled(UnitSystem())
+    return _renamed(shrunk, "stiff-millimetre-parts",
+                    "The clearance pendulum shrunk to a 1 cm rod of 1 g, journal radius 0.1 mm "
+                    "and 1 um clearances, in SI units.", horizon=0.5, time_step=1e-4)
