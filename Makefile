@@ -5,7 +5,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test venv lint siconos clean
+.PHONY: demo test venv lint siconos clean chromium regress ci
 
 venv: $(STAMP)
 
