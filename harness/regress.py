@@ -37,8 +37,10 @@ DEFAULT_SUITE = [
     {"id": "incline-stick", "scene": "incline-stick", "engine": "reference", "horizon": 0.3},
     {"id": "sliding-box", "scene": "sliding-box", "engine": "reference", "horizon": 0.5},
     {"id": "pendulum", "scene": "pendulum", "engine": "reference", "horizon": 1.0},
+    # 0.1 s: covers the first impacts in the clearance, before the rattling motion amplifies
+    # round-off (a baseline must not depend on the last bit of the machine's arithmetic).
     {"id": "clearance-pendulum", "scene": "clearance-pendulum", "engine": "reference",
-     "horizon": 0.3},
+     "horizon": 0.1},
 ]
 
 #: Tolerances written into a new baseline.
