@@ -5,7 +5,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test venv lint siconos clean chromium regress ci
+.PHONY: demo test venv lint siconos clean clean-numba-cache chromium regress ci
 
 venv: $(STAMP)
 
@@ -57,3 +57,8 @@ siconos:
 
 clean:
 	rm -rf $(VENV) build *.egg-info
+
+# numba's on-disk cache does not notice edits to a compiled function's callees (an inlined
+# kernel edited in another module): after editing numba kernels, drop the caches.
+clean-numba-cache:
+	find . -path ./$(VENV) -prune -o \( -name '*.nbi' -o -name '*.nbc' \) -print -delete
