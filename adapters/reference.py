@@ -226,10 +226,13 @@ class _Recorder:
         self.velocities[i] = state.v
         self.omegas[i] = state.omega
         if result is not None:
-            impulse = result.contact_impulse * result.contact_active[..., None]
-            self.normal[i] = impulse[..., 0].sum(axis=1) / self.h
-            world = np.einsum("pkr,pkrj->pkj", impulse, result.contact_frame)
-            self.force[i] = world.sum(axis=1) / self.h
+            pairs, slots = np.nonzero(result.contact_active)
+            impulse = result.contact_impulse[pairs, slots]          # (k, 3) in contact frames
+            world = np.einsum("kr,krj->kj", impulse, result.contact_frame[pairs, slots])
+            self.normal[i] = np.bincount(pairs, impulse[:, 0], self.normal.shape[1]) / self.h
+            for axis in range(3):
+                self.force[i, :, axis] = np.bincount(pairs, world[:, axis],
+                                                     self.force.shape[1]) / self.h
             self.iterations[i] = self._iterations
             self.residual[i] = self._residual
             self.converged[i] = self._converged

@@ -31,7 +31,6 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from clearbench.scenarios.geometry import MAX_CONTACTS_PER_PAIR
-from clearbench.scenarios.quaternion import quat_integrate
 
 from .constraints import (
     bilateral_rows,
@@ -43,7 +42,7 @@ from .constraints import (
 from .contact_problem import ContactProblem, SolverOptions
 from .fc3d_solve import solve_contact_problem
 from .forces import applied_forces, rotation_matrices, spring_jacobians
-from .gyroscopic import gyroscopic_update
+from .gyroscopic import gyroscopic_update, integrate_orientations
 from .projection import solve_projection
 from .system import MultibodySystem, State
 
@@ -423,10 +422,7 @@ class MoreauJeanStepper:
         # Joint Jacobians at the predicted configuration q_k + theta h v_k: with theta = 1/2
         # this makes ideal joints second order in energy (at q_k the energy error is O(h)).
         x_mid = state.x + theta * h * state.v
-        p_mid = state.p.copy()
-        for b in range(sys_.body_count):
-            if not sys_.body_fixed[b]:
-                p_mid[b] = quat_integrate(state.p[b], theta * h * state.omega[b])
+        p_mid = integrate_orientations(state.p, theta * h * state.omega, sys_.body_fixed)
         row_body, row_coef, _, target, pairs, slots = self._rows(
             t1, state.x, state.p, rotation, cand, active,
             bilateral_at=(x_mid, p_mid, rotation_matrices(p_mid)))
@@ -482,10 +478,8 @@ class MoreauJeanStepper:
         new_nu[sys_.body_fixed] = 0.0
         v_theta = theta * new_nu + (1.0 - theta) * nu
         x_new = state.x + h * v_theta[:, :3]
-        p_new = state.p.copy()
-        for b in range(sys_.body_count):
-            if not sys_.body_fixed[b]:
-                p_new[b] = quat_integrate(state.p[b], h * v_theta[b, 3:])
+        p_new = integrate_orientations(state.p, np.ascontiguousarray(h * v_theta[:, 3:]),
+                                       sys_.body_fixed)
         new_state = State(t1, x_new, p_new, new_nu[:, :3].copy(), new_nu[:, 3:].copy())
         return new_state, impulses, solve, closed
 
@@ -539,9 +533,8 @@ class MoreauJeanStepper:
             solve = solve_projection(w, values, n_equal, 0.1 * cfg.position_tolerance)
             delta = (y @ solve.delta).reshape(-1, 6)
             state.x += delta[:, :3]
-            for b in range(sys_.body_count):
-                if not sys_.body_fixed[b]:
-                    state.p[b] = quat_integrate(state.p[b], delta[b, 3:])
+            state.p[:] = integrate_orientations(state.p, np.ascontiguousarray(delta[:, 3:]),
+                                                sys_.body_fixed)
         return cfg.max_projection_iterations, worst, False
 
 
