@@ -21,7 +21,7 @@ import numpy as np
 
 from .contacts import ContactPair
 from .element import Element
-from .shapes import Circle, Cylinder, Plane, Shape
+from .shapes import Arc, Circle, Cylinder, Plane, Shape
 from .validation import (
     LENGTH,
     SceneError,
@@ -33,6 +33,9 @@ from .validation import (
     dim,
     dimensionless,
 )
+
+#: Quarter arcs per thrust face of a clearance joint (see ClearanceRevoluteJoint.expand).
+THRUST_ARCS = 4
 
 
 def check_unit_axis(field: str, value: object, tolerance: float = 1e-6) -> tuple:
@@ -200,7 +203,13 @@ class ClearanceRevoluteJoint(Element):
             with the joint's name.
         contacts : list of ContactPair
             ``<name>.ring_bottom`` / ``<name>.ring_top`` (rings against the journal) and
-            ``<name>.flange_bottom`` / ``<name>.flange_top`` (end-face rings against flanges).
+            ``<name>.flange_bottom_k`` / ``<name>.flange_top_k``, k = 0..3 (the quarters of
+            each end-face ring against its flange).
+
+        Each end face meets its flange through four quarter arcs rather than one circle: when
+        the faces are parallel a circle touches at one arbitrary point, whose off-axis force
+        would tilt the bearing; four quarters let the axial force act on the axis, as the
+        distributed contact of a real thrust face does.
         """
         axis = np.asarray(self.axis, dtype=float)
         anchor = np.asarray(self.anchor, dtype=float)
@@ -237,10 +246,13 @@ class ClearanceRevoluteJoint(Element):
                 Circle(f"{n}.ring_{side}", position=position, orientation=orientation,
                        radius=self.bore_radius)
             )
-            bearing_shapes.append(
-                Circle(f"{n}.thrust_{side}", position=position, orientation=orientation,
-                       radius=self.thrust_radius)
-            )
+            for quarter in range(THRUST_ARCS):
+                start = 2.0 * math.pi * quarter / THRUST_ARCS
+                bearing_shapes.append(
+                    Arc(f"{n}.thrust_{side}_{quarter}", position=position,
+                        orientation=orientation, radius=self.thrust_radius, start_angle=start,
+                        end_angle=start + 2.0 * math.pi / THRUST_ARCS)
+                )
             # Flange plane: material on the far side, normal pointing back toward the bearing.
             flange_point = anchor + sign * flange_distance * axis
             position, orientation = local(journal_pose, flange_point, -sign * axis)
@@ -253,11 +265,13 @@ class ClearanceRevoluteJoint(Element):
                             shape_a=f"{n}.ring_{side}", body_b=self.journal_body,
                             shape_b=f"{n}.journal", **common)
             )
-            contacts.append(
-                ContactPair(f"{n}.flange_{side}", body_a=self.bearing_body,
-                            shape_a=f"{n}.thrust_{side}", body_b=self.journal_body,
-                            shape_b=f"{n}.flange_{side}", **common)
-            )
+            for quarter in range(THRUST_ARCS):
+                contacts.append(
+                    ContactPair(f"{n}.flange_{side}_{quarter}", body_a=self.bearing_body,
+                                shape_a=f"{n}.thrust_{side}_{quarter}",
+                                body_b=self.journal_body, shape_b=f"{n}.flange_{side}",
+                                **common)
+                )
         return journal_shapes, bearing_shapes, contacts
 
 

@@ -11,7 +11,7 @@ from .bodies import Body, Motion
 from .contacts import ContactPair
 from .drivers import Driver
 from .expectations import Expectation
-from .inertia import diagonal, solid_sphere
+from .inertia import diagonal
 from .joints import ClearanceRevoluteJoint, RevoluteJoint
 from .outputs import BodyAngle, PointPosition
 from .registry import register
@@ -27,10 +27,25 @@ def _rotation_about_y(angle: float) -> tuple:
     return (math.cos(0.5 * angle), 0.0, math.sin(0.5 * angle), 0.0)
 
 
-def _pendulum_bob(initial_angle: float, length: float, mass: float, bob_radius: float) -> Body:
-    """Body whose frame origin is the pivot, centre of mass ``length`` below it at rest, tilted
-    by ``initial_angle`` about world y."""
-    return Body("bob", mass=mass, inertia=solid_sphere(mass, bob_radius),
+ROD_RADIUS_RATIO = 0.02  # radius of the pendulum rod per unit length (its small axial moment)
+
+
+def pendulum_rod_inertia(mass: float, length: float) -> tuple:
+    """Inertia about the centre of mass of a uniform rod of length 2 ``length`` hung from one
+    end (centre of mass ``length`` below the pivot), axis along body z [kg m^2]."""
+    transverse = mass * (2.0 * length) ** 2 / 12.0
+    radius = ROD_RADIUS_RATIO * length
+    return diagonal(transverse, transverse, 0.5 * mass * radius**2)
+
+
+def _pendulum_bob(initial_angle: float, length: float, mass: float) -> Body:
+    """A uniform rod whose frame origin is the pivot, centre of mass ``length`` below it at
+    rest, tilted by ``initial_angle`` about world y.
+
+    A rod rather than a point bob: a point bob has almost no inertia about its centre of mass,
+    so in a clearance joint it could spin about its centre while the bore whirls round the
+    journal; that mode is not what a pendulum test is about."""
+    return Body("bob", mass=mass, inertia=pendulum_rod_inertia(mass, length),
                 center_of_mass=(0.0, 0.0, -length), orientation=_rotation_about_y(initial_angle))
 
 
@@ -43,12 +58,13 @@ PENDULUM_OUTPUTS = (
 @register("pendulum", tags=("smoke", "analytic", "joints"),
           summary="pendulum on an ideal revolute joint: energy conserved, elliptic period")
 def pendulum(initial_angle: float = 1.0, length: float = 1.0, mass: float = 1.0,
-             bob_radius: float = 0.05) -> Scene:
-    bob = _pendulum_bob(initial_angle, length, mass, bob_radius)
-    pivot_inertia = 0.4 * mass * bob_radius**2 + mass * length**2
+             ) -> Scene:
+    bob = _pendulum_bob(initial_angle, length, mass)
+    pivot_inertia = pendulum_rod_inertia(mass, length)[0][0] + mass * length**2
     return Scene(
         name="pendulum",
-        description=f"Physical pendulum ({mass} kg, {length} m) on an ideal revolute joint, "
+        description=f"Rod pendulum ({mass} kg, centre of mass {length} m below the pivot) on an "
+        "ideal revolute joint, "
         f"released from rest at {initial_angle} rad: energy conserved, period from the "
         "complete elliptic integral.",
         horizon=10.0,
@@ -71,7 +87,7 @@ def pendulum(initial_angle: float = 1.0, length: float = 1.0, mass: float = 1.0,
           summary="pendulum on a 3D revolute joint with radial and axial clearance")
 def clearance_pendulum(radial_clearance: float = 1e-4, axial_clearance: float = 1e-4,
                        initial_angle: float = 1.0, length: float = 1.0, mass: float = 1.0,
-                       bob_radius: float = 0.05, journal_radius: float = 0.01,
+                       journal_radius: float = 0.01,
                        bearing_length: float = 0.02, friction: float = 0.1,
                        restitution: float = 0.0) -> Scene:
     """The pendulum of ``pendulum`` hung on a clearance joint: a journal of radius
@@ -79,7 +95,7 @@ def clearance_pendulum(radial_clearance: float = 1e-4, axial_clearance: float = 
     journal_radius + radial_clearance, with flanges leaving ``axial_clearance`` of axial play.
     The bore starts concentric with the journal; as the clearance goes to zero the motion must
     approach the ideal pendulum."""
-    bob = _pendulum_bob(initial_angle, length, mass, bob_radius)
+    bob = _pendulum_bob(initial_angle, length, mass)
     joint = ClearanceRevoluteJoint(
         "pivot", journal_body="ground", bearing_body="bob", anchor=(0.0, 0.0, 0.0), axis=Y_AXIS,
         journal_radius=journal_radius, radial_clearance=radial_clearance,

@@ -47,7 +47,8 @@ def test_tags_select_scenes():
 def test_features_are_derived_from_content():
     assert "restitution" not in get_scene("bouncing-ball-e0").features
     assert "restitution" in get_scene("bouncing-ball-e0.5").features
-    assert {"clearance_joints", "rings", "pair:circle-cylinder", "pair:circle-plane"} <= (
+    assert {"clearance_joints", "rings", "arcs", "pair:circle-cylinder",
+            "pair:arc-plane"} <= (
         get_scene("clearance-pendulum").features
     )
     assert "closed_loop" in get_scene("slider-crank").features

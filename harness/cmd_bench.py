@@ -1,0 +1,111 @@
+"""``clearbench bench NAME``: benchmarks that print figures (and write figures), never assert.
+
+Each benchmark is a function registered in :data:`BENCHMARKS`; ``clearbench bench --list``
+shows them.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from .cli import UserError
+
+
+def bench_reference(args: argparse.Namespace) -> int:
+    from .benchmarks import reference_step_costs
+
+    print("Reference engine, wall time of stepping (best of 3, after a warm-up that compiles)")
+    print(f"{'scene':<20} {'steps':>6} {'active contacts':>16} {'us/step':>9} "
+          f"{'us/contact/iteration':>21}")
+    for cost in reference_step_costs():
+        per_contact = cost.microseconds_per_contact_iteration
+        print(f"{cost.scene:<20} {cost.steps:>6} {cost.mean_active_contacts:>16.1f} "
+              f"{cost.microseconds_per_step:>9.1f} {per_contact:>21.3f}")
+    return 0
+
+
+def bench_clearance_ladder(args: argparse.Namespace) -> int:
+    from .benchmarks import clearance_ladder, plot_clearance_ladder
+
+    rungs = clearance_ladder()
+    print("Frictionless clearance pendulum vs the exact ideal pendulum, 0.5 s")
+    print(f"{'clearance [m]':>14} {'step [s]':>9} {'angle error [rad]':>18} "
+          f"{'excess [m]':>11} {'converged':>9} {'stepping [s]':>12}")
+    for r in rungs:
+        print(f"{r.clearance:>14.0e} {r.time_step:>9.0e} {r.angle_error:>18.3e} "
+              f"{r.excess:>11.1e} {str(r.converged):>9} {r.stepping_seconds:>12.2f}")
+    out = Path(args.out or "reports/figures/clearance_ladder.png")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    plot_clearance_ladder(rungs, out)
+    print(f"figure: {out}")
+    return 0
+
+
+def bench_reference_physics(args: argparse.Namespace) -> int:
+    from .benchmarks import engine_physics_table
+
+    steps = tuple(float(x) for x in args.dt) if args.dt else (None,)
+    rows = engine_physics_table("reference", "default", steps, args.tag)
+    print("Reference engine against each library scene's expectations (scene units)")
+    print(f"{'scene':<20} {'h':>8} {'expectation':<16} {'figure':<28} {'value':>12} "
+          f"{'converged':>9}")
+    for r in rows:
+        print(f"{r.scene:<20} {r.time_step:>8.0e} {r.expectation:<16} {r.figure:<28} "
+              f"{r.value:>12.3e} {str(r.converged):>9}")
+    return 0
+
+
+def bench_flores_reference(args: argparse.Namespace) -> int:
+    from clearbench.adapters.base import RunSettings
+    from clearbench.adapters.reference import create
+    from clearbench.scenarios.registry import get_scene
+
+    from .expectations import evaluate
+
+    scene = get_scene("flores-slider-crank")
+    trajectory = create().run(scene, RunSettings(time_step=1e-5, record_every=10))
+    out = Path(args.out or "reports/trajectories/flores-slider-crank_reference.npz")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    trajectory.save(out)
+    print(f"Flores-Leine-Glocker slider-crank, reference engine, h = 1e-5 s, 0.2 s: "
+          f"{trajectory.steps} steps in {trajectory.stepping_seconds:.1f} s, "
+          f"unconverged steps: {len(trajectory.metadata['unconverged_steps'])}")
+    for result in evaluate(scene, trajectory):
+        print(f"  {result.name}: " + ", ".join(f"{k} = {v:.3e}" for k, v in result.figures.items()))
+    print(f"trajectory (every 10th step): {out}")
+    return 0
+
+
+BENCHMARKS = {
+    "flores-reference": (bench_flores_reference,
+                         "keeps the reference trajectory of the Flores slider-crank (h = 1e-5 s)"),
+    "reference-physics": (bench_reference_physics,
+                          "the reference engine against every scene's expectations"),
+    "reference": (bench_reference, "us per step and per contact-iteration of the reference"),
+    "clearance-ladder": (bench_clearance_ladder,
+                         "clearance pendulum -> ideal pendulum as the clearance shrinks"),
+}
+
+
+def register(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "bench", help="run a benchmark (prints figures, asserts nothing)",
+        description="Benchmarks: " + "; ".join(f"{k}: {v[1]}" for k, v in BENCHMARKS.items()),
+    )
+    parser.add_argument("name", nargs="?", help="benchmark name (see --list)")
+    parser.add_argument("--list", action="store_true", help="list the benchmarks")
+    parser.add_argument("--out", help="where a benchmark writes its figure")
+    parser.add_argument("--dt", nargs="+", help="time steps (scene units), where it applies")
+    parser.add_argument("--tag", help="only scenes with this tag, where it applies")
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.list or not args.name:
+        for name, (_, summary) in BENCHMARKS.items():
+            print(f"{name:<20} {summary}")
+        return 0
+    if args.name not in BENCHMARKS:
+        raise UserError(f"unknown benchmark {args.name!r}; benchmarks: {', '.join(BENCHMARKS)}")
+    return BENCHMARKS[args.name][0](args)
