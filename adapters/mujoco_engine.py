@@ -47,7 +47,7 @@ from clearbench.scenarios.validation import (
 
 from .base import Capability, Engine, RunSettings
 from .mujoco_capabilities import clearance_summary, mujoco_capabilities, ring_summary
-from .mujoco_settings import PRESETS, MujocoSettings, resolve_settings
+from .mujoco_settings import OPTION_NAMES, PRESETS, MujocoSettings, resolve_settings
 from .trajectory import RunStatus, Trajectory
 
 logger = logging.getLogger(__name__)
@@ -56,6 +56,9 @@ logger = logging.getLogger(__name__)
 ENERGY_EXPECTATIONS = ("energy_non_increasing", "energy_conserved")
 #: Features that do work the energy bookkeeping does not count (the guard stays off).
 WORK_FEATURES = ("drivers", "point_forces", "moments")
+
+
+__all__ = ["OPTION_NAMES", "PRESETS", "MujocoEngine", "availability", "create"]
 
 
 def availability() -> tuple[bool, str]:

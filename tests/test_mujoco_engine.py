@@ -5,6 +5,7 @@ scene says."""
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -28,6 +29,7 @@ from clearbench.scenarios.units import MM_G_MS
 
 NAMES = scene_names()
 G = 9.81
+GUARD_MESSAGE = re.compile(r"energy gain|non-finite|MuJoCo warning")
 
 
 def _figures(scene, trajectory, name):
@@ -40,6 +42,11 @@ def test_library_scene_runs_a_short_horizon(name, preset):
     scene = get_scene(name)
     horizon = 20 * scene.time_step  # fast suite; full horizons in the slow test below
     trajectory = create(preset).run(scene, RunSettings(horizon=horizon))
+    if "stiff" in scene.tags and trajectory.status is RunStatus.DIVERGED:
+        # The stiff suite is built to break engines: a guard stopping it is a valid outcome
+        # (measured: stiff-spring, whose explicit MuJoCo spring blows up), with the reason.
+        assert GUARD_MESSAGE.search(trajectory.message), trajectory.message
+        return
     assert trajectory.status is RunStatus.OK, trajectory.message
     assert trajectory.steps == 20
     assert trajectory.times[-1] == pytest.approx(horizon, rel=1e-9)
@@ -61,12 +68,14 @@ def test_library_scene_runs_to_its_horizon_or_is_stopped_by_a_guard(name, preset
     scene = get_scene(name)
     trajectory = create(preset).run(scene, RunSettings(record_every=10))
     if trajectory.status is RunStatus.OK:
-        assert trajectory.times[-1] == pytest.approx(scene.horizon, rel=1e-9)
+        # Whole steps up to the horizon (the last may pass it when dt does not divide it).
+        assert scene.horizon - 1e-9 <= trajectory.times[-1] < scene.horizon + scene.time_step
     else:
         # Measured: the Flores slider-crank with MuJoCo's default contacts (timeconst 0.02 s:
-        # the slider sinks 35 mm into its guide) gains 11 % energy; the guard stops it.
+        # the slider sinks 35 mm into its guide) gains 11 % energy, and some scenes of the
+        # stiff suite blow up; a guard stops them and says why.
         assert trajectory.status is RunStatus.DIVERGED
-        assert "energy gain" in trajectory.message
+        assert GUARD_MESSAGE.search(trajectory.message), trajectory.message
 
 
 def _box_on_plane(friction: float = 0.5, tilt: float = 0.0, swap: bool = False) -> Scene:
@@ -290,7 +299,8 @@ def test_clearance_joint_forces_are_reported_on_its_own_pairs():
     trajectory = create("tuned").run(scene, RunSettings(horizon=0.5))
     names = trajectory.contact_names
     rings = [names.index("pivot.ring_bottom"), names.index("pivot.ring_top")]
-    flanges = [names.index("pivot.flange_bottom"), names.index("pivot.flange_top")]
+    flanges = [k for k, name in enumerate(names) if name.startswith("pivot.flange")]
+    assert len(flanges) == 8  # four quarter arcs of each end face against its flange
     # Hanging at rest: the two bearing rings carry the weight; the force is the one on body
     # B of each pair, the journal's ground (-weight); the flanges carry nothing.
     total = trajectory.contact_force[-1, rings].sum(axis=0)

@@ -84,11 +84,12 @@ def test_contact_parameters_lengthen_the_timeconst_for_enough_steps_per_contact(
     assert half_period >= settings.restitution_contact_steps * dt * (1 - 1e-12)
     # Linear spring: constant impedance d0 = dmax.
     assert chosen.solimp[0] == chosen.solimp[1] == settings.solimp[1]
-    # e = 0 pairs keep the preset's solref (2 dt, 1) unless map_plastic is set.
-    plastic = contact_parameters(0.0, settings, dt)
+    # tuned maps e = 0 to the plastic ratio 3; without map_plastic e = 0 pairs keep the
+    # preset's solref (2 dt, 1); MuJoCo's default keeps (0.02, 1).
+    assert contact_parameters(0.0, settings, dt).solref[1] == 3.0
+    plastic = contact_parameters(0.0, resolve_settings("tuned", {"map_plastic": False}), dt)
     assert not plastic.mapped and plastic.solref == (2 * dt, 1.0)
-    mapped = contact_parameters(0.0, resolve_settings("tuned", {"map_plastic": True}), dt)
-    assert mapped.solref[1] == 3.0
+    assert contact_parameters(0.0, resolve_settings("default"), dt).solref == (0.02, 1.0)
 
 
 def test_time_step_guard_flags_stiff_and_overdamped_constraints():
