@@ -89,7 +89,6 @@ class BuiltModel:
     contact_parameters: list[ContactParameters]
     hinge_springs: list = field(default_factory=list)  # (load, qpos address, sign)
     warnings: list[str] = field(default_factory=list)
-    notes: list[str] = field(default_factory=list)
     initial_velocity_residual: float = 0.0
 
 
@@ -126,7 +125,6 @@ def build_model(scene: Scene, settings: MujocoSettings, time_step: float) -> Bui
     _set_options(spec, scene, settings, time_step)
 
     warnings: list[str] = []
-    notes: list[str] = []
     spec_bodies = {}
     for link in topology.links:
         body = expanded.body(link.body)
@@ -218,7 +216,7 @@ def build_model(scene: Scene, settings: MujocoSettings, time_step: float) -> Bui
     hinge_springs = [(load, int(model.joint(f"{body}:hinge").qposadr[0]), sign)
                      for load, body, sign in hinge_springs]
     built = BuiltModel(model, data, topology, body_ids, pair_lookup, contact_body_b, driven,
-                       python_loads, rings, parameters, hinge_springs, warnings, notes)
+                       python_loads, rings, parameters, hinge_springs, warnings)
     # Preloads are constant motor controls: set after the reset of the initial state.
     controls = [(model.actuator(name).id, value) for name, value in controls]
     _set_initial_state(built, scene, controls)

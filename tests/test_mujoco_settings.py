@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from clearbench.adapters.mujoco_engine import _profile_integral, _profile_slope
+from clearbench.adapters.mujoco_run import profile_integral, profile_slope
 from clearbench.adapters.mujoco_settings import (
     PRESETS,
     contact_parameters,
@@ -152,8 +152,8 @@ def test_driver_profile_integral_and_slope(times, values):
     t = np.linspace(0.0, 2.5, 251)
     exact = np.array([driver.displacement(float(x)) for x in t])
     # Both exact for piecewise-linear profiles: only round-off differs.
-    assert np.allclose(_profile_integral(times, values, t), exact, rtol=1e-12, atol=1e-12)
-    slope = _profile_slope(times, values, t)
+    assert np.allclose(profile_integral(times, values, t), exact, rtol=1e-12, atol=1e-12)
+    slope = profile_slope(times, values, t)
     h = 1e-7
     numeric = (np.asarray(driver.velocity(t + h)) - np.asarray(driver.velocity(t))) / h
     away_from_knots = np.min(np.abs(t[:, None] - np.asarray(times)[None, :]), axis=1) > 1e-3
