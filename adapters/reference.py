@@ -24,7 +24,7 @@ import numpy as np
 
 from clearbench.ref_solver.contact_problem import SolverOptions
 from clearbench.ref_solver.stepper import MoreauJeanStepper, StepperSettings
-from clearbench.scenarios.quaternion import quat_to_matrix
+from clearbench.scenarios.quaternion import quat_rotate_batch
 from clearbench.scenarios.scene import Scene
 
 from .base import Capability, Engine, RunSettings, Support
@@ -244,9 +244,7 @@ class _Recorder:
 
     def store(self, i: int, state, result) -> None:
         self.times[i] = state.t
-        for b in range(state.x.shape[0]):
-            rotation = quat_to_matrix(state.p[b])
-            self.positions[i, b] = state.x[b] - rotation @ self.com[b]
+        self.positions[i] = state.x - quat_rotate_batch(state.p, self.com)
         self.orientations[i] = state.p
         self.velocities[i] = state.v
         self.omegas[i] = state.omega
