@@ -271,25 +271,20 @@ def _sticks(scene, trajectory, exp):
         "displacement", ""
 
 
-def _energy_scale(scene, trajectory, energy):
-    return max(float(np.max(np.abs(energy.kinetic))), float(np.ptp(energy.gravity)),
-               float(np.ptp(energy.springs)), 1e-300)
-
-
 def _energy_non_increasing(scene, trajectory, exp):
     energy = metrics.energy(scene, trajectory)
-    total = energy.total
-    growth = float(np.max(total - np.minimum.accumulate(total)))
+    growth = metrics.energy_growth(scene, trajectory, energy)
     return ({"energy_growth": growth,
-             "energy_growth_relative": growth / _energy_scale(scene, trajectory, energy)},
-            "energy_growth_relative", "largest rise above the running minimum")
+             "energy_growth_relative": growth / metrics.energy_scale(scene, energy)},
+            "energy_growth_relative",
+            "largest rise above the running minimum, on contact-free samples when there are any")
 
 
 def _energy_conserved(scene, trajectory, exp):
     energy = metrics.energy(scene, trajectory)
     drift = float(np.max(np.abs(energy.total - energy.total[0])))
     return ({"energy_drift": drift,
-             "energy_drift_relative": drift / _energy_scale(scene, trajectory, energy)},
+             "energy_drift_relative": drift / metrics.energy_scale(scene, energy)},
             "energy_drift_relative", "")
 
 

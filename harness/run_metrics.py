@@ -108,13 +108,9 @@ def shape_size(shape) -> float:
 
 
 def _body_size(body) -> float:
-    sizes = []
-    for shape in body.shapes:
-        if hasattr(shape, "half_extents"):
-            sizes.append(float(np.linalg.norm(shape.half_extents)))
-        elif hasattr(shape, "radius"):
-            sizes.append(float(shape.radius) + float(getattr(shape, "half_length", 0.0)))
-    return max(sizes + [float(np.linalg.norm(body.center_of_mass))])
+    from . import metrics
+
+    return metrics.body_size(body)
 
 
 def scene_size(scene: Scene) -> float:
@@ -286,14 +282,10 @@ def _stiction(scene, trajectory, metrics, out: _Collector) -> None:
 
 
 def energy_scale(scene: Scene, energy) -> float:
-    """Energy a run is judged against [M L^2/T^2]: the largest of the peak kinetic energy, the
-    range of potential energy, and sum of m |g| size over free bodies."""
-    gravity = float(np.linalg.norm(scene.gravity))
-    weight = sum(b.mass * gravity * _body_size(b) for b in scene.bodies
-                 if b.motion is not Motion.FIXED)
-    potential = energy.gravity + energy.springs
-    scale = max(float(np.max(energy.kinetic)), float(np.ptp(potential)), weight)
-    return scale if scale > 0 else 1.0
+    """The shared energy scale (:func:`clearbench.harness.metrics.energy_scale`)."""
+    from . import metrics
+
+    return metrics.energy_scale(scene, energy)
 
 
 def _energy(scene, trajectory, metrics, out: _Collector, reasons: list[str]) -> None:
@@ -304,7 +296,7 @@ def _energy(scene, trajectory, metrics, out: _Collector, reasons: list[str]) -> 
     scale = energy_scale(scene, energy)
     out.put("energy_scale", scale)
     out.put("energy_drift", np.max(np.abs(total - total[0])) / scale)
-    growth = float(np.max(total - np.minimum.accumulate(total))) / scale
+    growth = metrics.energy_growth(scene, trajectory, energy) / scale
     out.put("energy_growth", growth)
     must_not_grow = any(e.kind in ("energy_non_increasing", "energy_conserved")
                         for e in scene.expectations)
