@@ -18,6 +18,7 @@ COMMAND_MODULES: tuple[str, ...] = (
     "clearbench.harness.cmd_c60_extract",
     "clearbench.harness.cmd_fclib",
     "clearbench.harness.cmd_bench",
+    "clearbench.harness.cmd_c60",
 )
 
 

@@ -442,7 +442,13 @@ def _unsigned_initial_angle(body: str) -> float:
     return abs(float(_body_entry(body)["rotation_angle"]))
 
 
-def c60_loads(handle_spring_arm: str = "source", bar_moment_sign: float = -1.0) -> list:
+#: Preload term of the contact-pressure law in the source [rad] (its comment lists 0.6547 and
+#: 0.9599 as other values).
+CONTACT_SPRING_PRELOAD = 0.49
+
+
+def c60_loads(handle_spring_arm: str = "source", bar_moment_sign: float = -1.0,
+              contact_spring_preload: float = CONTACT_SPRING_PRELOAD) -> list:
     """The 4 loads of the sheet as scene loads (see the module docstring)."""
     sheet = {item["name"]: item for item in load_model()["loads"]}
     handle = sheet["handle_spring"]
@@ -470,7 +476,7 @@ def c60_loads(handle_spring_arm: str = "source", bar_moment_sign: float = -1.0) 
         ),
         AngleLawLoad(
             "contact_pressure_spring", axis=Z_AXIS, stiffness=float(contact["stiffness"]),
-            offset=math.radians(54.54 + 22.0) + 0.49,
+            offset=math.radians(54.54 + 22.0) + contact_spring_preload,
             angle_bodies=("moving_contact", "plate"), angle_coefficients=(1.0, -1.0),
             applications=(
                 LoadApplication("plate", "force", (-1.1, 0.9, 0.0), "body", plate_centre,
@@ -571,6 +577,7 @@ def c60_scene(
     time_step: float = 1e-3,
     handle_spring_arm: str = "source",
     bar_moment_sign: float = -1.0,
+    contact_spring_preload: float = CONTACT_SPRING_PRELOAD,
     extra_shapes: Mapping[str, tuple[Shape, ...]] | None = None,
     extra_bodies: tuple[Body, ...] = (),
     extra_contacts: tuple[ContactPair, ...] = (),
@@ -597,6 +604,8 @@ def c60_scene(
         ``source`` (the source's moment, default) or ``design`` (see the module docstring).
     bar_moment_sign : float
         Sign of the tripping bar's settling moment about world z (-1: the source's).
+    contact_spring_preload : float
+        Preload term of the contact-pressure law [rad] (0.49: the source's).
     extra_shapes : mapping body -> shapes, optional
         Shapes added to the sheet's bodies (e.g. the tripping-bar pin a probe pushes).
     extra_bodies, extra_contacts, extra_drivers, extra_outputs : tuples
@@ -630,7 +639,7 @@ def c60_scene(
         time_step=time_step,
         bodies=tuple(_bodies(shapes)) + tuple(extra_bodies),
         contacts=tuple(pairs) + tuple(extra_contacts),
-        loads=tuple(c60_loads(handle_spring_arm, bar_moment_sign)),
+        loads=tuple(c60_loads(handle_spring_arm, bar_moment_sign, contact_spring_preload)),
         drivers=tuple(drivers) + tuple(extra_drivers),
         outputs=tuple(outputs) + tuple(extra_outputs),
         expectations=tuple(expectations) or (Expectation("no_penetration",

@@ -8,7 +8,8 @@
   with the prototype's clearances (Table 7), see :mod:`.c60_bench`.
 
 Every factory takes ``clearances`` (joint -> radial clearance [mm]), ``time_step`` and
-``horizon`` [ms] where it applies, and ``handle_spring_arm`` (see :mod:`.c60_model`).
+``horizon`` [ms] where it applies, and ``handle_spring_arm`` (see :mod:`.c60_model`);
+``c60-on`` also ``contact_spring_preload`` [rad] (the source's 0.49 by default).
 """
 
 from __future__ import annotations
@@ -28,10 +29,12 @@ SETTLED_AFTER = 3.0
 @register("c60-on", tags=("c60",),
           summary="C-60 breaker in its ON pose: settles, stays latched; FC-1..FC-6")
 def c60_on(clearances: Mapping[str, float] | None = None, horizon: float = 7.0,
-           time_step: float = 1e-3, handle_spring_arm: str = "source") -> Scene:
+           time_step: float = 1e-3, handle_spring_arm: str = "source",
+           contact_spring_preload: float = c60_model.CONTACT_SPRING_PRELOAD) -> Scene:
     return c60_model.c60_scene(
         "c60-on", clearances=clearances, horizon=horizon, time_step=time_step,
         handle_spring_arm=handle_spring_arm, plunger_speed=0.0,
+        contact_spring_preload=contact_spring_preload,
         expectations=(
             Expectation("no_penetration", kind="no_penetration"),
             Expectation("stays_latched", kind="sticks", body="hook",
