@@ -1,9 +1,11 @@
-"""Contact offsets in the reference engine: the offset is taken on body A's side, so a closed
-contact acts at one point on both bodies and friction exerts no spurious moment."""
+"""Contacts in the reference engine: the offset is taken on body A's side (a closed contact
+acts at one point on both bodies, friction exerts no spurious moment), and a contact whose
+candidate vanishes (sliding off a bounded face) is dropped by the projection."""
 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from clearbench.adapters.base import RunSettings
 from clearbench.adapters.reference import create
@@ -59,3 +61,30 @@ def test_oblique_frictional_impact_with_an_offset_conserves_angular_momentum():
     assert tangential_impulse > 1e-2  # friction did act
     bound = step * 1.5 * tangential_impulse  # relative speed 1.5
     assert np.max(np.abs(angular - angular[0])) < bound
+
+
+def test_a_contact_that_slides_off_a_bounded_face_is_dropped_not_projected():
+    # A ball slides off the edge of a rectangle face: at some step its contact is active at
+    # q_k and has no candidate any more at q_{k+1} (its point is beyond the face). The
+    # projection must drop it, not project onto an empty slot (infinite gap -> NaN state).
+    from clearbench.scenarios.bodies import Motion
+    from clearbench.scenarios.shapes import Rectangle
+
+    scene = Scene(
+        "off-the-edge", horizon=0.2, time_step=1e-3,
+        bodies=(Body("table", motion=Motion.FIXED, shapes=(Rectangle("top", half_extents=(
+            0.5, 0.5)),)),
+                Body("ball", mass=1.0, inertia=diagonal(4e-3, 4e-3, 4e-3),
+                     position=(0.45, 0.0, 0.1), velocity=(1.0, 0.0, 0.0),
+                     shapes=(Sphere("s", radius=0.1),))),
+        contacts=(ContactPair("ball_top", body_a="table", shape_a="top", body_b="ball",
+                              shape_b="s", friction=0.0),),
+        tags=("test",))
+    trajectory = create().run(scene, RunSettings())
+    assert trajectory.status.value == "ok", trajectory.message
+    x = trajectory.positions[:, 1]
+    assert np.isfinite(x).all()
+    # Supported until its centre passes the edge (0.05 s at 1 m/s), then it falls under
+    # gravity: 0.5 g t^2 = 0.011 m over the remaining 0.15 s, within the step's O(g h t).
+    assert x[-1, 0] == pytest.approx(0.65, abs=1e-9)
+    assert x[-1, 2] == pytest.approx(0.1 - 0.5 * 9.81 * 0.15**2, abs=2e-3)
