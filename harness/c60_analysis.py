@@ -53,46 +53,50 @@ class TripEvents:
     """Times [ms] of the magnetic trip (NaN when it did not happen in the run).
 
     strike: the plunger first pushes the tripping bar (TRIP contacts carry force);
-    release: the hook's last latch contact on the tripping bar (C4, C5) unloads for good;
-    opening: C7 (moving on fixed contact) unloads for good and its gap exceeds 0.01 mm;
-    final_gap: C7's gap at the end of the run [mm].
+    release: after the strike, the hook's latch contacts on the tripping bar (C4, C5) first
+    carry no force (the latch let go);
+    opening: after the release, C7's gap (moving on fixed contact) first exceeds ``open_gap``
+    (0.1 mm: clear of the chatter within the joints' clearances that follows the release);
+    chatter: C7's closures (force > 0 after a sample with none) between release and opening;
+    gap_after: C7's smallest gap over the ``after`` ms following the opening [mm] (> 0: the
+    contacts did not close again).
     """
 
     strike: float
     release: float
     opening: float
-    final_gap: float
+    chatter: int
+    gap_after: float
 
     @property
     def opening_after_strike(self) -> float:
         return self.opening - self.strike
 
 
-def _last_loaded(force: np.ndarray, times: np.ndarray) -> float:
-    """Time after which ``force`` (T,) stays at zero for good (NaN if loaded at the end)."""
-    loaded = np.nonzero(force > FORCE_THRESHOLD)[0]
-    if loaded.size == 0:
-        return math.nan
-    last = loaded[-1]
-    return math.nan if last == len(times) - 1 else float(times[last + 1])
+def _first(mask: np.ndarray, times: np.ndarray, after: float) -> float:
+    hits = np.nonzero(mask & (times > after))[0]
+    return float(times[hits[0]]) if hits.size else math.nan
 
 
-def trip_events(scene: Scene, trajectory: Trajectory, open_gap: float = 0.01) -> TripEvents:
+def trip_events(scene: Scene, trajectory: Trajectory, open_gap: float = 0.1,
+                after: float = 1.0) -> TripEvents:
     names = trajectory.contact_names
     force = trajectory.contact_normal_force
+    times = trajectory.times
     trip = [i for i, n in enumerate(names) if n.startswith("TRIP_")]
-    pushed = np.nonzero(force[:, trip].sum(axis=1) > FORCE_THRESHOLD)[0]
-    strike = float(trajectory.times[pushed[0]]) if pushed.size else math.nan
+    strike = _first(force[:, trip].sum(axis=1) > FORCE_THRESHOLD, times, -math.inf)
     latch = [i for i, n in enumerate(names) if n.startswith(("Hook_Tbar_C4", "Tbar_Hook_C5"))]
-    release = _last_loaded(force[:, latch].sum(axis=1), trajectory.times)
+    release = _first(force[:, latch].sum(axis=1) <= FORCE_THRESHOLD, times, strike)
     c7 = names.index(model.C7)
-    gaps = metrics.contact_gaps(scene, trajectory)[:, scene.contacts.index(
-        next(c for c in scene.contacts if c.name == model.C7))]
-    opening = _last_loaded(force[:, c7], trajectory.times)
-    if not math.isnan(opening):
-        beyond = np.nonzero((trajectory.times >= opening) & (gaps > open_gap))[0]
-        opening = float(trajectory.times[beyond[0]]) if beyond.size else math.nan
-    return TripEvents(strike, release, opening, float(gaps[-1]))
+    column = [c.name for c in scene.contacts].index(model.C7)
+    gaps = metrics.contact_gaps(scene, trajectory)[:, column]
+    opening = _first((force[:, c7] <= FORCE_THRESHOLD) & (gaps > open_gap), times, release)
+    between = (times > release) & (times < opening)
+    loaded = force[:, c7] > FORCE_THRESHOLD
+    chatter = int(np.sum(loaded[1:] & ~loaded[:-1] & between[1:]))
+    window = (times >= opening) & (times <= opening + after)
+    gap_after = float(np.min(gaps[window])) if window.any() else math.nan
+    return TripEvents(strike, release, opening, chatter, gap_after)
 
 
 @dataclass(frozen=True)
@@ -168,26 +172,27 @@ def _patch_ranges() -> dict[tuple[str, str], tuple[float, float]]:
     ranges = {}
     for contact in model.load_model()["contacts"]:
         for side in ("1", "2"):
-            items = [p for p in model.primitives()[contact[f"cad{side}"]].primitives
-                     if isinstance(p, prim.Cylinder) and not isinstance(p, prim.Ring)
-                     and not p.is_full and p.material != "outside"]
-            for primitive in items:
-                stem = contact[f"cad{side}"].rsplit("/", 1)[-1].removesuffix(".stp")
-                labels = model._face_labels(contact[f"cad{side}"], len(
-                    [q for q in model.primitives()[contact[f"cad{side}"]].primitives
-                     if not isinstance(q, prim.Point)]))
-                index = model.primitives()[contact[f"cad{side}"]].primitives.index(primitive)
-                label = labels[index] if len(labels) > 1 else ""
-                name = stem + (f"_{label}" if label else "")
+            cad = contact[f"cad{side}"]
+            surfaces = [p for p in model.primitives()[cad].primitives
+                        if not isinstance(p, prim.Point)]
+            labels = model._face_labels(cad, len(surfaces))
+            for label, primitive in zip(labels, surfaces, strict=True):
+                if (not isinstance(primitive, prim.Cylinder) or isinstance(primitive, prim.Ring)
+                        or primitive.is_full or primitive.material == "outside"):
+                    continue
+                name = cad.rsplit("/", 1)[-1].removesuffix(".stp") + (
+                    f"_{label}" if label else "")
                 ranges[(contact[f"body{side}"], name)] = (primitive.start_angle,
                                                           primitive.end_angle)
     return ranges
 
 
-def patch_excursions(scene: Scene, trajectory: Trajectory) -> dict[str, float]:
+def patch_excursions(scene: Scene, trajectory: Trajectory, end: float = math.inf
+                     ) -> dict[str, float]:
     """For every contact pair on a convex cylinder PATCH (modelled as a full cylinder), the
     largest angle [rad] by which a contact point that carries force lies outside the CAD
-    patch's angular range (0 when it always stays on the patch), over the recorded samples."""
+    patch's angular range (0 when it always stays on the patch), over the recorded samples
+    up to time ``end`` [ms]."""
     ranges = _patch_ranges()
     bodies = {b.name: b for b in scene.bodies}
     out = {}
@@ -205,7 +210,9 @@ def patch_excursions(scene: Scene, trajectory: Trajectory) -> dict[str, float]:
             a, b = bodies[contact.body_a], bodies[contact.body_b]
             ia, ib = scene.body_index(contact.body_a), scene.body_index(contact.body_b)
             ib_side = ia if side == "a" else ib
-            for t in np.nonzero(trajectory.contact_normal_force[:, column] > FORCE_THRESHOLD)[0]:
+            carrying = (trajectory.contact_normal_force[:, column] > FORCE_THRESHOLD) & (
+                trajectory.times <= end)
+            for t in np.nonzero(carrying)[0]:
                 pose_a = (trajectory.positions[t, ia], trajectory.orientations[t, ia])
                 pose_b = (trajectory.positions[t, ib], trajectory.orientations[t, ib])
                 result = contacts_between(a.shape(contact.shape_a), pose_a,

@@ -153,9 +153,11 @@ def validate(cache: Path | None = None, preset: str = "default", speed_check: bo
                            note="no published figure"))
     report.rows.append(Row("c60-trip: latch released (C4, C5 unloaded)", "ms", events.release,
                            note="no published figure"))
-    report.rows.append(Row("c60-trip: contacts open (C7 unloaded, gap > 0.01 mm)", "ms",
-                           events.opening, note=f"no published figure; C7 gap at 20 ms "
-                           f"{events.final_gap:.3f} mm"))
+    report.rows.append(Row("c60-trip: contacts open (C7 gap > 0.1 mm)", "ms",
+                           events.opening, note=f"no published figure; {events.chatter} C7 "
+                           f"re-closures between release and opening; smallest C7 gap in the "
+                           f"1 ms after: {events.gap_after:.3f} mm"))
+    report.findings.append(_trip_failure(trip))
 
     # Bench: contact force vs displacement (prototype clearances).
     contact = run("contact_force_test", "c60-contact-force-test", {}, record_every=20)
@@ -415,3 +417,22 @@ def write_figures(report: ValidationReport, directory: Path) -> dict[str, Path]:
         plt.close(figure)
         out["Contact force vs displacement"] = path
     return out
+
+
+def _trip_failure(run: Run) -> str:
+    """The reference engine's trouble in the run, where it happened (step, contact, figures)."""
+    trajectory = run.trajectory
+    projections = list(trajectory.metadata.get("unconverged_projections", []))
+    depth = metrics.penetration(run.scene, trajectory)
+    worst = int(np.argmax(depth.max(axis=0))) if depth.size else 0
+    text = (f"c60-trip: {len(run.unconverged)} step(s) whose contact problem did not converge "
+            f"{run.unconverged[:5]}, {len(projections)} whose projection did not converge")
+    if projections:
+        first = projections[0]
+        name = run.scene.contacts[worst].name
+        onset = float(trajectory.times[np.argmax(depth[:, worst] > 1e-6)])
+        text += (f", from step {first} (t = {first * trajectory.time_step:.3f} ms) on: the "
+                 f"handle, spinning freely after the trip (no OFF stop in the source's "
+                 f"contacts), is moved by the projection out of its J1 bearing; largest "
+                 f"penetration {depth.max():.3f} mm ({name}, from t = {onset:.3f} ms)")
+    return text + "."
