@@ -175,7 +175,7 @@ def _patch_ranges() -> dict[tuple[str, str], tuple[float, float]]:
             cad = contact[f"cad{side}"]
             surfaces = [p for p in model.primitives()[cad].primitives
                         if not isinstance(p, prim.Point)]
-            labels = model._face_labels(cad, len(surfaces))
+            labels = model.face_labels(cad, len(surfaces))
             for label, primitive in zip(labels, surfaces, strict=True):
                 if (not isinstance(primitive, prim.Cylinder) or isinstance(primitive, prim.Ring)
                         or primitive.is_full or primitive.material == "outside"):
@@ -204,7 +204,9 @@ def patch_excursions(scene: Scene, trajectory: Trajectory, end: float = math.inf
                 continue
             start, end = ranges[(body, shape_name)]
             shape = bodies[body].shape(shape_name)
-            assert isinstance(shape, Cylinder)
+            if not isinstance(shape, Cylinder):
+                raise TypeError(f"{body}.{shape_name} is a {shape.kind}, not the cylinder "
+                                "a convex patch is modelled by")
             worst = 0.0
             column = trajectory.contact_index(contact.name)
             a, b = bodies[contact.body_a], bodies[contact.body_b]

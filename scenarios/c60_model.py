@@ -286,7 +286,8 @@ def _contact_primitives(cad_path: str) -> list[prim.Primitive]:
     return [p for p in primitives()[cad_path].primitives if not isinstance(p, prim.Point)]
 
 
-def _face_labels(cad_path: str, count: int) -> list[str]:
+def face_labels(cad_path: str, count: int) -> list[str]:
+    """Labels of the faces of a contact surface file (empty for a single face)."""
     if count == 1:
         return [""]
     if Path(cad_path).stem == "Tbar_hook_wedge_surface_C4" and count == len(WEDGE_FACES):
@@ -367,7 +368,7 @@ def _contact_geometry(offsets: Mapping[str, float], poses: Mapping[str, Pose]):
                               for p in _representative_points(q)], axis=0)
             names = []
             items = _contact_primitives(cad)
-            for label, primitive in zip(_face_labels(cad, len(items)), items, strict=True):
+            for label, primitive in zip(face_labels(cad, len(items)), items, strict=True):
                 name = _file_stem(cad) + (f"_{label}" if label else "")
                 bore = isinstance(primitive, prim.Cylinder) and _is_bore(
                     primitive, poses[body], partner, partner_pose)
