@@ -12,6 +12,8 @@ import math
 import numpy as np
 
 from clearbench.ref_solver.system import (
+    FORCE_ANGLE_LAW,
+    FORCE_DISTANCE_LAW,
     FORCE_LINEAR_SPRING,
     FORCE_MOMENT,
     FORCE_POINT_FORCE,
@@ -23,7 +25,15 @@ from clearbench.ref_solver.system import (
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.drivers import COMPONENTS
 from clearbench.scenarios.geometry import contact_frame, pack_shape_parameters, shape_code
-from clearbench.scenarios.loads import LinearSpringDamper, Moment, PointForce, TorsionalSpringDamper
+from clearbench.scenarios.loads import (
+    AngleLawLoad,
+    DistanceLawLoad,
+    LinearSpringDamper,
+    LoadApplication,
+    Moment,
+    PointForce,
+    TorsionalSpringDamper,
+)
 from clearbench.scenarios.quaternion import (
     quat_conjugate,
     quat_multiply,
@@ -122,7 +132,54 @@ def build_system(scene: Scene) -> MultibodySystem:
         dref.append(p[b])
     # force elements
     fk, fa, fb, fp = [], [], [], []
+
+    def application_parameters(prm, application: LoadApplication, a: int, b: int,
+                               scalar_is_moment: bool) -> None:
+        target = index[application.body]
+        prm[7] = 0.0 if target == a else 1.0
+        prm[8] = 1.0 if application.action == "moment" else 0.0
+        prm[9] = 1.0 if application.frame == "body" else 0.0
+        prm[10:13] = application.unit_direction()
+        prm[13:16] = np.asarray(application.point) - com[target]
+        prm[16] = application.gain(scalar_is_moment)
+
     for load in scene.loads:
+        if isinstance(load, AngleLawLoad | DistanceLawLoad):
+            if isinstance(load, AngleLawLoad):
+                names = load.angle_bodies
+                if len(names) > 2:
+                    raise ValueError(f"load {load.name!r}: the reference engine takes angle "
+                                     f"laws of at most two bodies, got {names}")
+            else:
+                names = (load.body_a, load.body_b)
+            a, b = index[names[0]], index[names[-1]]
+            for application in load.applications:
+                if application.body not in names:
+                    raise ValueError(
+                        f"load {load.name!r}: the reference engine applies a law load only to "
+                        f"the bodies of its law {names}, not to {application.body!r}")
+                prm = np.zeros(24)
+                if isinstance(load, AngleLawLoad):
+                    coefficients = list(load.angle_coefficients) + [0.0]
+                    prm[0:3] = load.axis
+                    prm[3] = load.stiffness
+                    prm[4] = load.offset
+                    prm[5] = coefficients[0]
+                    prm[6] = coefficients[1] if len(names) == 2 else 0.0
+                    application_parameters(prm, application, a, b, True)
+                    kind = FORCE_ANGLE_LAW
+                else:
+                    prm[0:3] = np.asarray(load.point_a) - com[a]
+                    prm[3:6] = np.asarray(load.point_b) - com[b]
+                    prm[17] = load.stiffness
+                    prm[18] = load.rest_length
+                    application_parameters(prm, application, a, b, False)
+                    kind = FORCE_DISTANCE_LAW
+                fk.append(kind)
+                fa.append(a)
+                fb.append(b)
+                fp.append(prm)
+            continue
         prm = np.zeros(24)
         if isinstance(load, LinearSpringDamper):
             a, b = index[load.body_a], index[load.body_b]

@@ -3,7 +3,9 @@
 - :func:`reference_step_costs`: wall time per step and per contact per solver iteration on the
   clearance pendulum and on a scene with more than 100 active contacts (box grid);
 - :func:`clearance_ladder`: the frictionless clearance pendulum against the exact ideal
-  pendulum on a ladder of clearances, with a figure.
+  pendulum on a ladder of clearances, with a figure;
+- :func:`c60_costs`: wall time per run and per step of the full C-60 runs (c60-trip, c60-on)
+  with the solver's iteration and residual statistics.
 """
 
 from __future__ import annotations
@@ -169,3 +171,49 @@ def engine_physics_table(engine_name: str = "reference", preset: str = "default"
                                            value, bool(trajectory.solver_converged.all()),
                                            trajectory.stepping_seconds))
     return rows
+
+
+@dataclass(frozen=True)
+class C60Cost:
+    """Measured cost and solver statistics of one C-60 run (one core)."""
+
+    scene: str
+    preset: str
+    steps: int
+    stepping_seconds: float
+    solver_seconds: float
+    mean_active_contacts: float
+    mean_iterations: float      # solver iterations per step (summed over activation rounds)
+    median_residual: float      # of the recorded steps' largest residual
+    max_residual: float
+    unconverged_steps: int
+
+    @property
+    def milliseconds_per_step(self) -> float:
+        return 1e3 * self.stepping_seconds / self.steps
+
+
+def c60_costs(presets: tuple[str, ...] = ("default", "newton"),
+              scenes: tuple[tuple[str, dict], ...] = (("c60-trip", {}), ("c60-on", {}))
+              ) -> list[C60Cost]:
+    """Wall time of full C-60 runs (c60-trip: 20 ms at the source's step 1e-3 ms; c60-on:
+    7 ms) with each preset, after a 20-step warm-up run that compiles the kernels."""
+    out = []
+    for preset in presets:
+        engine = create(preset)
+        for name, parameters in scenes:
+            scene = get_scene(name, **parameters)
+            engine.run(scene, RunSettings(horizon=20 * scene.time_step))
+            trajectory = engine.run(scene, RunSettings())
+            residual = trajectory.solver_residual[1:]
+            out.append(C60Cost(
+                scene=name, preset=preset, steps=trajectory.steps,
+                stepping_seconds=trajectory.stepping_seconds,
+                solver_seconds=trajectory.metadata["solver_seconds"],
+                mean_active_contacts=float(np.mean(trajectory.active_contacts[1:])),
+                mean_iterations=float(np.mean(trajectory.solver_iterations[1:])),
+                median_residual=float(np.nanmedian(residual)),
+                max_residual=float(np.nanmax(residual)),
+                unconverged_steps=len(trajectory.metadata["unconverged_steps"]),
+            ))
+    return out

@@ -25,6 +25,7 @@ COMMAND_MODULES: tuple[str, ...] = (
     "clearbench.harness.cmd_bench_mujoco",
     "clearbench.harness.cmd_fclib",
     "clearbench.harness.cmd_bench",
+    "clearbench.harness.cmd_c60",
 )
 
 

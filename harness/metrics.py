@@ -175,7 +175,11 @@ def stiction(scene: Scene, trajectory: Trajectory, body: str, start: float = 0.0
 @dataclass(frozen=True)
 class Energy:
     """(T,) kinetic, gravitational potential and spring potential energy, and their total
-    [M L^2 / T^2]. Time-switched forces, moments and drivers do work not counted here."""
+    [M L^2 / T^2]. Time-switched forces, moments and drivers do work not counted here, and so
+    do law loads (``angle_law``, ``distance_law``): their forces are not the gradient of a
+    potential in general (a torsion law applied as a force on a body-fixed lever, a distance
+    law pushing along a body axis), so no potential energy exists to count for them; see
+    :func:`non_conservative_loads`."""
 
     kinetic: np.ndarray
     gravity: np.ndarray
@@ -215,6 +219,15 @@ def energy(scene: Scene, trajectory: Trajectory) -> Energy:
                                  scene.body_index(load.body_b), load.axis)
             springs += load.preload * phi + 0.5 * load.stiffness * (phi - load.rest_angle) ** 2
     return Energy(kinetic, potential, springs)
+
+
+def non_conservative_loads(scene: Scene) -> tuple[str, ...]:
+    """Names of the loads whose work :func:`energy` cannot count (law loads, time-switched
+    forces and moments): an energy expectation is meaningless while they act."""
+    from clearbench.scenarios.loads import AngleLawLoad, DistanceLawLoad, Moment, PointForce
+
+    return tuple(load.name for load in scene.loads
+                 if isinstance(load, AngleLawLoad | DistanceLawLoad | PointForce | Moment))
 
 
 def relative_angle(trajectory: Trajectory, body_a: int, body_b: int, axis) -> np.ndarray:

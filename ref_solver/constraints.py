@@ -213,8 +213,11 @@ def contact_candidates(x, rotation, shape_kind, shape_parameters, shape_body, sh
                        frame, count):
     """Evaluate every contact pair: up to MAX_CONTACTS_PER_PAIR candidates each.
 
-    Outputs (npair, K, ...) arrays: ``gap`` = geometric gap - offset, world points on each
-    shape, contact frames (rows n, t1, t2; n from A toward B); ``count`` (npair,).
+    Outputs (npair, K, ...) arrays: ``gap`` = geometric gap - offset, world points, contact
+    frames (rows n, t1, t2; n from A toward B); ``count`` (npair,). The offset is taken on A's
+    side: A's point is moved by ``offset`` along n, so that ``p_B - p_A = gap n`` holds for the
+    offset gap too and a closed contact acts at one point on both bodies (otherwise its
+    friction forces, a distance ``offset`` apart, would exert a spurious moment).
     """
     for k in range(pair_a.shape[0]):
         sa = pair_a[k]
@@ -229,8 +232,11 @@ def contact_candidates(x, rotation, shape_kind, shape_parameters, shape_body, sh
                           shape_kind[sb], shape_parameters[sb], pos_b, rot_b,
                           gap[k], point_a[k], point_b[k], frame[k])
         count[k] = n
+        offset = pair_offset[k]
         for c in range(n):
-            gap[k, c] -= pair_offset[k]
+            gap[k, c] -= offset
+            for i in range(3):
+                point_a[k, c, i] += offset * frame[k, c, 0, i]
 
 
 @njit(cache=True)

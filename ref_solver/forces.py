@@ -15,6 +15,15 @@ the centre of mass, body axes):
 - point force: [0:3] point on the body, [3:6] force, [6] 0 world / 1 body axes, [7] start time,
   [8] end time (active start <= t < end).
 - moment: [0:3] moment, [3] 0 world / 1 body axes, [4] start time, [5] end time.
+- angle law (one element per application of a scene's law load; at most two law bodies, A and
+  B, equal when the law has one body): [0:3] world axis, [3] stiffness, [4] offset, [5], [6]
+  coefficients of theta(A) and theta(B); s = k (offset + c_A theta_A + c_B theta_B), theta the
+  absolute twist angle of the body about the axis (2 atan2(a . vee(R - R^T), 1 + tr R)).
+- distance law: [0:3] point on A, [3:6] point on B, [17] stiffness, [18] rest length;
+  s = k (rest - |p_B - p_A|).
+- both laws, the application: [7] 0 on A / 1 on B, [8] 0 force / 1 moment, [9] 0 world / 1 body
+  axes, [10:13] unit direction, [13:16] point of a force (relative to the centre of mass, body
+  axes), [16] gain: the force or moment is gain * s along the direction.
 """
 
 from __future__ import annotations
@@ -28,11 +37,16 @@ from clearbench.scenarios.quaternion import quat_exp, quat_multiply, quat_to_mat
 
 from .linalg3 import cross, dot, mat_t_vec, mat_vec
 from .system import (
+    CONFIGURATION_FORCES,
+    FORCE_ANGLE_LAW,
+    FORCE_DISTANCE_LAW,
     FORCE_LINEAR_SPRING,
     FORCE_MOMENT,
     FORCE_POINT_FORCE,
     FORCE_TORSIONAL_SPRING,
 )
+
+_CONFIGURATION_FORCES = np.array(CONFIGURATION_FORCES, dtype=np.int64)
 
 
 @njit(cache=True)
@@ -64,6 +78,31 @@ def _add_torque(out, body, rotation, torque_world):
 @njit(cache=True, inline="always")
 def _point_velocity(v, omega, rotation, body, local):
     return v[body] + mat_vec(rotation[body], cross(omega[body], local))
+
+
+@njit(cache=True, inline="always")
+def twist_angle(rotation, axis):
+    """Absolute rotation angle [rad] of a body about the unit world ``axis``: 2 atan2(q . axis,
+    q_w) for its quaternion q with q_w >= 0, from its rotation matrix (3, 3)."""
+    vee_x = rotation[2, 1] - rotation[1, 2]
+    vee_y = rotation[0, 2] - rotation[2, 0]
+    vee_z = rotation[1, 0] - rotation[0, 1]
+    trace = rotation[0, 0] + rotation[1, 1] + rotation[2, 2]
+    return 2.0 * math.atan2(axis[0] * vee_x + axis[1] * vee_y + axis[2] * vee_z, 1.0 + trace)
+
+
+@njit(cache=True, inline="always")
+def _apply_law(out, x, rotation, body, prm, scalar):
+    """Apply ``scalar`` through the application stored in prm[8:17] to ``body``."""
+    direction = prm[10:13].copy()
+    if prm[9] > 0.5:
+        direction = mat_vec(rotation[body], direction)
+    value = prm[16] * scalar
+    if prm[8] > 0.5:
+        _add_torque(out, body, rotation, value * direction)
+    else:
+        point = x[body] + mat_vec(rotation[body], prm[13:16])
+        _add_force_at(out, body, x, rotation, point, value * direction)
 
 
 @njit(cache=True)
@@ -102,6 +141,18 @@ def element_forces(t, x, rotation, v, omega, kinds, body_a, body_b, parameters, 
             moment = -(prm[12] + prm[9] * (angle - prm[11]) + prm[10] * rate)
             _add_torque(out, b, rotation, moment * axis)
             _add_torque(out, a, rotation, -moment * axis)
+        elif kind == FORCE_ANGLE_LAW:
+            axis = prm[0:3]
+            theta_a = twist_angle(rotation[a], axis)
+            theta_b = twist_angle(rotation[b], axis)
+            scalar = prm[3] * (prm[4] + prm[5] * theta_a + prm[6] * theta_b)
+            _apply_law(out, x, rotation, b if prm[7] > 0.5 else a, prm, scalar)
+        elif kind == FORCE_DISTANCE_LAW:
+            pa = x[a] + mat_vec(rotation[a], prm[0:3])
+            pb = x[b] + mat_vec(rotation[b], prm[3:6])
+            d = pb - pa
+            scalar = prm[17] * (prm[18] - math.sqrt(dot(d, d)))
+            _apply_law(out, x, rotation, b if prm[7] > 0.5 else a, prm, scalar)
         elif kind == FORCE_POINT_FORCE and not springs_only:
             if prm[7] <= t < prm[8]:
                 force = prm[3:6].copy()
@@ -149,9 +200,10 @@ def spring_jacobians(t, x, p, v, omega, fixed, kinds, body_a, body_b, parameters
     damping = np.zeros((n, n))
     involved = np.zeros(nb, dtype=np.bool_)
     for e in range(kinds.shape[0]):
-        if kinds[e] == FORCE_LINEAR_SPRING or kinds[e] == FORCE_TORSIONAL_SPRING:
-            involved[body_a[e]] = True
-            involved[body_b[e]] = True
+        for code in _CONFIGURATION_FORCES:
+            if kinds[e] == code:
+                involved[body_a[e]] = True
+                involved[body_b[e]] = True
     rotation = rotation_matrices(p)
     base = np.zeros((nb, 6))
     element_forces(t, x, rotation, v, omega, kinds, body_a, body_b, parameters, True, base)

@@ -381,7 +381,10 @@ class MoreauJeanStepper:
         when given)."""
         sys_ = self.system
         nbil = sys_.bilateral_row_count
-        pairs, slots = np.nonzero(active)
+        # Only slots that hold a candidate at this configuration: a pair's candidate count can
+        # drop between the activation and the projection (a point sliding off a bounded face),
+        # and an empty slot has no point, no frame and an infinite gap.
+        pairs, slots = np.nonzero(self._slots(cand, active))
         m = nbil + 3 * len(pairs)
         row_body = np.full((m, 2), -1, dtype=np.int64)
         row_coef = np.zeros((m, 2, 6))

@@ -38,6 +38,11 @@ FORCE_TORSIONAL_SPRING = 1
 FORCE_POINT_FORCE = 2
 FORCE_MOMENT = 3
 FORCE_LEVER_SPRING = 4
+FORCE_ANGLE_LAW = 5
+FORCE_DISTANCE_LAW = 6
+#: Force elements that depend on the configuration (linearised implicitly by the stepper).
+CONFIGURATION_FORCES = (FORCE_LINEAR_SPRING, FORCE_TORSIONAL_SPRING, FORCE_LEVER_SPRING,
+                        FORCE_ANGLE_LAW, FORCE_DISTANCE_LAW)
 
 
 @dataclass(frozen=True)
@@ -112,8 +117,7 @@ class MultibodySystem:
     @property
     def has_springs(self) -> bool:
         """True when some force element depends on the configuration or velocity."""
-        return bool(np.isin(self.force_kind, (FORCE_LINEAR_SPRING, FORCE_TORSIONAL_SPRING,
-                                              FORCE_LEVER_SPRING)).any())
+        return bool(np.isin(self.force_kind, CONFIGURATION_FORCES).any())
 
 
 @dataclass

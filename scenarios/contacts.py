@@ -23,8 +23,10 @@ class ContactPair(Element):
     of ``body_b``.
 
     The gap used by every engine and metric is the signed distance between the two shapes minus
-    ``offset`` (the C-60 data sheet varies radial clearances through the offset). The contact
-    normal points from A toward B (see :mod:`.geometry`).
+    ``offset`` (the C-60 data sheet varies radial clearances through the offset). The offset is
+    taken on A's side, as the C-60 source does: A's contact point is moved by ``offset`` along
+    the normal, so a closed contact acts at one point on both bodies. The contact normal points
+    from A toward B (see :mod:`.geometry`).
 
     Parameters
     ----------

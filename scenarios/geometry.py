@@ -63,6 +63,18 @@ arc-plane          1   lowest point of the circle if its angle lies in the arc, 
                        end. Arc parallel to the plane: its middle point.
 circle-cylinder    1   bearing ring against a journal, or ring against a pin (below).
 arc-cylinder       1   the same, restricted to the arc's angles (else the better arc end).
+rectangle-X       0-8  X = sphere, cylinder, circle, arc: the plane pair, keeping only the
+disc-X                 candidates whose point on the face lies inside the face (|x| <= half_x,
+                       |y| <= half_y; or x^2 + y^2 <= r^2). A contact that slides off the face
+                       is lost (edges are not modelled). Gap and normal are the plane's.
+circle-bore       0-1  ring INSIDE a bore: g = R_bore - (largest distance of a ring point from
+arc-bore               the bore axis), n radially outward from that ring point (parallel axes at
+                       eccentricity e: g = R_bore - R_ring - e). Kept only if the point on the
+                       bore lies in its angles and |z| <= half_length (a concave CAD patch).
+cylinder-bore     0-2  journal INSIDE a bore: one candidate at each end of the axial overlap
+                       (the radial gap is concave along the axis, so these are its minima): the
+                       journal's end rim when it is inside the bore, else the bore's end rim
+                       against the journal's lateral surface. No overlap: none.
 ================  ===  ==========================================================================
 
 Ring (circle or arc) against cylinder. The cylinder is the journal: its lateral surface is
@@ -124,13 +136,16 @@ from .geometry_frames import (
 )
 from .geometry_pairs import (
     ARC,
+    BORE,
     BOX,
     CAPSULE,
     CIRCLE,
     CYLINDER,
+    DISC,
     MAX_CONTACTS_PER_PAIR,
     PARAMETER_COUNT,
     PLANE,
+    RECTANGLE,
     SHAPE_KIND_NAMES,
     SPHERE,
     SUPPORTED,
@@ -143,15 +158,18 @@ if TYPE_CHECKING:  # the kernels and this module never need the scene dataclasse
 
 __all__ = [
     "ARC",
+    "BORE",
     "BOX",
     "CAPSULE",
     "CIRCLE",
     "CYLINDER",
+    "DISC",
     "FRAME_POLE",
     "FRAME_SINGULAR_DIRECTION",
     "MAX_CONTACTS_PER_PAIR",
     "PARAMETER_COUNT",
     "PLANE",
+    "RECTANGLE",
     "SHAPE_CODES",
     "SPHERE",
     "PairContacts",
@@ -183,6 +201,9 @@ _PACKED_FIELDS: dict[str, tuple[str, ...]] = {
     "plane": (),
     "circle": ("radius",),
     "arc": ("radius", "start_angle", "end_angle"),
+    "rectangle": ("half_extents",),
+    "disc": ("radius",),
+    "bore": ("radius", "half_length", "start_angle", "end_angle"),
 }
 
 
@@ -249,6 +270,9 @@ def pack_shape_parameters(shape: Shape) -> np.ndarray:
     plane     []
     circle    [radius]
     arc       [radius, start_angle, end_angle] (rad)
+    rectangle [half_x, half_y]
+    disc      [radius]
+    bore      [radius, half_length, start_angle, end_angle] (rad)
     ========  ============================================
 
     Unused entries are 0. Lengths in the scene's unit.

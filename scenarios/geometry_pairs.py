@@ -30,7 +30,11 @@ CYLINDER = 3
 PLANE = 4
 CIRCLE = 5
 ARC = 6
-SHAPE_KIND_NAMES = ("sphere", "box", "capsule", "cylinder", "plane", "circle", "arc")
+RECTANGLE = 7
+DISC = 8
+BORE = 9
+SHAPE_KIND_NAMES = ("sphere", "box", "capsule", "cylinder", "plane", "circle", "arc",
+                    "rectangle", "disc", "bore")
 NUMBER_OF_KINDS = len(SHAPE_KIND_NAMES)
 
 #: Length of the packed parameter vector of every shape.
@@ -54,6 +58,17 @@ CANONICAL_PAIRS = (
     (CAPSULE, CAPSULE),
     (CIRCLE, CYLINDER),
     (ARC, CYLINDER),
+    (RECTANGLE, SPHERE),
+    (RECTANGLE, CYLINDER),
+    (RECTANGLE, CIRCLE),
+    (RECTANGLE, ARC),
+    (DISC, SPHERE),
+    (DISC, CYLINDER),
+    (DISC, CIRCLE),
+    (DISC, ARC),
+    (CIRCLE, BORE),
+    (ARC, BORE),
+    (CYLINDER, BORE),
 )
 
 _CANONICAL = np.zeros((NUMBER_OF_KINDS, NUMBER_OF_KINDS), dtype=np.bool_)
@@ -730,8 +745,12 @@ def _ring_critical_angles(a1, b1, a2, b2):
 
 
 @njit(cache=True)
-def _ring_angle(centre_offset, e1, e2, ring_radius, axis, start_angle, span, is_arc):
-    """Angle of the ring (arc) point nearest the cylinder axis.
+def _ring_angle(centre_offset, e1, e2, ring_radius, axis, start_angle, span, is_arc, sign):
+    """Angle of the ring (arc) point nearest the cylinder axis (``sign`` = 1), or farthest from
+    it (``sign`` = -1: a ring inside a bore).
+
+    The farthest point is the nearest one for -f: every coefficient and every distance
+    comparison below is multiplied by ``sign``.
 
     The squared distance of the ring point c + rho (cos t e1 + sin t e2) to the axis line is,
     up to a constant, the trigonometric polynomial f = a1 cos t + b1 sin t + a2 cos 2t +
@@ -744,13 +763,13 @@ def _ring_angle(centre_offset, e1, e2, ring_radius, axis, start_angle, span, is_
     are possible) every stationary point is found from a quartic and the best is kept.
     """
     s = _axpy(-_dot(centre_offset, axis), axis, centre_offset)
-    a1 = 2.0 * ring_radius * _dot(s, e1)
-    b1 = 2.0 * ring_radius * _dot(s, e2)
+    a1 = sign * 2.0 * ring_radius * _dot(s, e1)
+    b1 = sign * 2.0 * ring_radius * _dot(s, e2)
     beta1 = _dot(e1, axis)
     beta2 = _dot(e2, axis)
     rho_squared = ring_radius * ring_radius
-    a2 = -0.5 * rho_squared * (beta1 * beta1 - beta2 * beta2)
-    b2 = -rho_squared * beta1 * beta2
+    a2 = -sign * 0.5 * rho_squared * (beta1 * beta1 - beta2 * beta2)
+    b2 = -sign * rho_squared * beta1 * beta2
     r1 = math.hypot(a1, b1)
     r2 = math.hypot(a2, b2)
     if r1 == 0.0 and r2 == 0.0:
@@ -771,14 +790,14 @@ def _ring_angle(centre_offset, e1, e2, ring_radius, axis, start_angle, span, is_
             if is_arc and not _arc_angle_in_range(angles[k], start_angle, span):
                 continue
             distance, _ = _ring_axis_distance(angles[k], centre_offset, e1, e2, ring_radius, axis)
-            if distance < best_distance:
-                best_angle, best_distance = angles[k], distance
+            if sign * distance < best_distance:
+                best_angle, best_distance = angles[k], sign * distance
         if not is_arc:
             return best_angle
     for theta in (start_angle, start_angle + span):
         distance, _ = _ring_axis_distance(theta, centre_offset, e1, e2, ring_radius, axis)
-        if distance < best_distance:
-            best_angle, best_distance = theta, distance
+        if sign * distance < best_distance:
+            best_angle, best_distance = theta, sign * distance
     return best_angle
 
 
@@ -797,7 +816,8 @@ def _ring_cylinder(ring_position, ring_rotation, ring_radius, start_angle, span,
     e1 = _column(ring_rotation, 0)
     e2 = _column(ring_rotation, 1)
     centre_offset = _sub(ring_position, cylinder_position)
-    theta = _ring_angle(centre_offset, e1, e2, ring_radius, axis, start_angle, span, is_arc)
+    theta = _ring_angle(centre_offset, e1, e2, ring_radius, axis, start_angle, span, is_arc,
+                        1.0)
     distance, perpendicular = _ring_axis_distance(theta, centre_offset, e1, e2, ring_radius,
                                                   axis)
     if distance > 0.0:
@@ -809,6 +829,123 @@ def _ring_cylinder(ring_position, ring_rotation, ring_radius, start_angle, span,
                                           _scale(e2, ring_radius * s)))
     _stage(stage, 0, distance - cylinder_radius, ring_point, inward)
     return 1
+
+
+# ------------------------------------------------------------------------------------------------
+# Bounded plane faces (rectangle, disc, A) against X (B): the plane kernels, then the candidates
+# whose point on the face lies outside its boundary are dropped.
+# ------------------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def _keep_inside_face(plane_position, plane_rotation, half_x, half_y, radius, count, stage):
+    """Keep the staged contacts whose point on A (row 1 of the stage) lies in the face:
+    |x| <= half_x and |y| <= half_y (rectangle, radius < 0) or x^2 + y^2 <= radius^2 (disc)
+    in the face's frame. Returns the number kept (compacted to the front, order preserved)."""
+    kept = 0
+    for k in range(count):
+        point = (stage[k, 1, 0], stage[k, 1, 1], stage[k, 1, 2])
+        local = _to_local(plane_position, plane_rotation, point)
+        if radius >= 0.0:
+            inside = local[0] * local[0] + local[1] * local[1] <= radius * radius
+        else:
+            inside = abs(local[0]) <= half_x and abs(local[1]) <= half_y
+        if inside:
+            if kept != k:
+                for i in range(3):
+                    for j in range(3):
+                        stage[kept, i, j] = stage[k, i, j]
+            kept += 1
+    return kept
+
+
+# ------------------------------------------------------------------------------------------------
+# Ring (circle or arc) or journal (cylinder) INSIDE a bore (A = ring or journal, B = bore)
+# ------------------------------------------------------------------------------------------------
+
+
+@njit(cache=True, inline="always")
+def _bore_angle_in_range(bore_position, bore_rotation, point, start_angle, span):
+    """True if the radial direction of ``point`` from the bore axis lies in the bore's angles."""
+    local = _to_local(bore_position, bore_rotation, point)
+    if span >= _TWO_PI:
+        return True
+    return _arc_angle_in_range(math.atan2(local[1], local[0]), start_angle, span)
+
+
+@njit(cache=True)
+def _ring_in_bore(ring_position, ring_rotation, ring_radius, start_angle, span, is_arc,
+                  bore_position, bore_rotation, bore_radius, bore_half_length, bore_start,
+                  bore_span, check_axial, index, stage):
+    """Ring (A) inside the bore (B): gap = bore radius - largest distance of a ring point from
+    the bore axis; the normal points from that ring point radially outward (from A into B).
+    The contact is kept only if its point on the bore lies within the bore's angles (and,
+    with ``check_axial``, within |z| <= half_length). Returns 1 if staged at ``index``, else 0.
+    """
+    axis = _column(bore_rotation, 2)
+    e1 = _column(ring_rotation, 0)
+    e2 = _column(ring_rotation, 1)
+    centre_offset = _sub(ring_position, bore_position)
+    theta = _ring_angle(centre_offset, e1, e2, ring_radius, axis, start_angle, span, is_arc,
+                        -1.0)
+    distance, perpendicular = _ring_axis_distance(theta, centre_offset, e1, e2, ring_radius,
+                                                  axis)
+    if distance > 0.0:
+        outward = _scale(perpendicular, 1.0 / distance)
+    else:
+        outward = _any_perpendicular(axis)
+    c, s = math.cos(theta), math.sin(theta)
+    ring_point = _add(ring_position, _add(_scale(e1, ring_radius * c),
+                                          _scale(e2, ring_radius * s)))
+    gap = bore_radius - distance
+    on_bore = _axpy(gap, outward, ring_point)
+    if check_axial and abs(_dot(_sub(on_bore, bore_position), axis)) > bore_half_length:
+        return 0
+    if not _bore_angle_in_range(bore_position, bore_rotation, on_bore, bore_start, bore_span):
+        return 0
+    _stage(stage, index, gap, ring_point, outward)
+    return 1
+
+
+@njit(cache=True)
+def _cylinder_in_bore(journal_position, journal_rotation, journal_radius, journal_half_length,
+                      bore_position, bore_rotation, bore_radius, bore_half_length, bore_start,
+                      bore_span, stage):
+    """Journal cylinder (A) inside the bore (B): one candidate at each end of their axial
+    overlap, where the radial gap of two nearly coaxial cylinders is smallest (it is concave
+    along the axis). An end inside the bore is the journal's end rim (ring in the bore); an end
+    where the journal runs beyond the bore is the bore's end rim against the journal's lateral
+    surface. No overlap: no candidate."""
+    axis_b = _column(bore_rotation, 2)
+    axis_j = _column(journal_rotation, 2)
+    direction = 1.0 if _dot(axis_j, axis_b) >= 0.0 else -1.0
+    centre = _dot(_sub(journal_position, bore_position), axis_b)
+    reach = journal_half_length * abs(_dot(axis_j, axis_b))
+    if centre - reach > bore_half_length or centre + reach < -bore_half_length:
+        return 0
+    count = 0
+    for end in (-1.0, 1.0):
+        if end * (centre + end * reach) > bore_half_length:
+            # The journal runs beyond this end of the bore: the bore's end rim.
+            rim_position = _axpy(end * bore_half_length, axis_b, bore_position)
+            is_arc = bore_span < _TWO_PI
+            _ring_cylinder(rim_position, bore_rotation, bore_radius, bore_start, bore_span,
+                           is_arc, journal_position, journal_rotation, journal_radius,
+                           stage[count:])
+            # Mirror into (A = journal, B = bore): normal from the journal outward.
+            gap = stage[count, 2, 0]
+            normal = (-stage[count, 0, 0], -stage[count, 0, 1], -stage[count, 0, 2])
+            rim_point = (stage[count, 1, 0], stage[count, 1, 1], stage[count, 1, 2])
+            _stage(stage, count, gap, _axpy(-gap, normal, rim_point), normal)
+            count += 1
+        else:
+            rim_position = _axpy(direction * end * journal_half_length, axis_j,
+                                 journal_position)
+            count += _ring_in_bore(rim_position, journal_rotation, journal_radius, 0.0,
+                                   _TWO_PI, False, bore_position, bore_rotation, bore_radius,
+                                   bore_half_length, bore_start, bore_span, False, count,
+                                   stage)
+    return count
 
 
 # ------------------------------------------------------------------------------------------------
@@ -839,6 +976,23 @@ def _canonical_contacts(kind_a, params_a, position_a, rotation_a, kind_b, params
             return _plane_ring(position_a, rotation_a, position_b, rotation_b, params_b[0],
                                params_b[1], params_b[2] - params_b[1], True, stage)
         return -1
+    if kind_a == RECTANGLE or kind_a == DISC:
+        radius = params_a[0] if kind_a == DISC else -1.0
+        if kind_b == SPHERE:
+            count = _plane_sphere(position_a, rotation_a, position_b, params_b[0], stage)
+        elif kind_b == CYLINDER:
+            count = _plane_cylinder(position_a, rotation_a, position_b, rotation_b, params_b[0],
+                                    params_b[1], stage)
+        elif kind_b == CIRCLE:
+            count = _plane_ring(position_a, rotation_a, position_b, rotation_b, params_b[0],
+                                0.0, _TWO_PI, False, stage)
+        elif kind_b == ARC:
+            count = _plane_ring(position_a, rotation_a, position_b, rotation_b, params_b[0],
+                                params_b[1], params_b[2] - params_b[1], True, stage)
+        else:
+            return -1
+        return _keep_inside_face(position_a, rotation_a, params_a[0], params_a[1], radius,
+                                 count, stage)
     if kind_b == SPHERE:
         if kind_a == SPHERE:
             return _sphere_sphere(position_a, params_a[0], position_b, params_b[0], stage)
@@ -857,6 +1011,22 @@ def _canonical_contacts(kind_a, params_a, position_a, rotation_a, kind_b, params
     if kind_a == CAPSULE and kind_b == CAPSULE:
         return _capsule_capsule(position_a, rotation_a, params_a[0], params_a[1], position_b,
                                 rotation_b, params_b[0], params_b[1], stage)
+    if kind_b == BORE:
+        bore_span = params_b[3] - params_b[2]
+        if kind_a == CIRCLE:
+            return _ring_in_bore(position_a, rotation_a, params_a[0], 0.0, _TWO_PI, False,
+                                 position_b, rotation_b, params_b[0], params_b[1], params_b[2],
+                                 bore_span, True, 0, stage)
+        if kind_a == ARC:
+            return _ring_in_bore(position_a, rotation_a, params_a[0], params_a[1],
+                                 params_a[2] - params_a[1], True, position_b, rotation_b,
+                                 params_b[0], params_b[1], params_b[2], bore_span, True, 0,
+                                 stage)
+        if kind_a == CYLINDER:
+            return _cylinder_in_bore(position_a, rotation_a, params_a[0], params_a[1],
+                                     position_b, rotation_b, params_b[0], params_b[1],
+                                     params_b[2], bore_span, stage)
+        return -1
     if kind_b == CYLINDER:
         if kind_a == CIRCLE:
             return _ring_cylinder(position_a, rotation_a, params_a[0], 0.0, _TWO_PI, False,

@@ -1,13 +1,26 @@
-"""Applied loads: spring-dampers (linear and torsional, with preload), point forces and moments.
+"""Applied loads: spring-dampers (linear and torsional, with preload), point forces and moments,
+and law loads (a scalar law of angles or of a distance, applied through listed forces and
+moments).
 
 Gravity is a scene-level vector (see :class:`.scene.Scene`). Forces and moments may be switched
 on at ``start_time`` and off at ``end_time`` (``None``: never switched off).
+
+Law loads express springs that a model applies as equivalent forces rather than as a spring
+between two points, as the C-60 source does: a torsion spring whose moment is applied as a force
+on a lever along a body axis, a distance spring pushing along a body axis instead of along its
+own line, a relative-angle torsion applied as forces and a moment. A law computes one scalar
+``s`` from the configuration; each :class:`LoadApplication` turns ``s`` into a force at a body
+point or a moment on a body. Such loads are in general NOT conservative (the applied forces are
+not the gradient of a potential of ``s``): energy metrics leave them out, and they do work that
+an energy balance must not expect back.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import Any, ClassVar
 
 from .element import Element
 from .joints import check_unit_axis
@@ -25,6 +38,7 @@ from .validation import (
     check_finite_vector,
     check_name,
     check_non_negative,
+    check_positive,
     dim,
     dimensionless,
 )
@@ -157,8 +171,188 @@ class Moment(Load):
         return (self.body,)
 
 
+ACTIONS = ("force", "moment")
+
+
+@dataclass(frozen=True)
+class LoadApplication:
+    """How the scalar ``s`` of a law load acts on one body.
+
+    Parameters
+    ----------
+    body : str
+        The body acted on.
+    action : str
+        ``force``: a force ``value * d`` at ``point``; ``moment``: a moment ``value * d``.
+    direction : (3,) tuple
+        Any non-zero vector (normalised when applied) ``d``, in ``frame`` axes.
+    frame : str
+        ``body`` (the direction turns with the body) or ``world``.
+    point : (3,) tuple
+        Point of application of a force, body frame from the body origin [L]; must stay at the
+        origin for a moment.
+    coefficient : float
+        Dimensionless factor.
+    lever : float or None
+        Arm [L] converting between the law's scalar and the action, where their dimensions
+        differ: an angle law (s is a moment) applies a force ``coefficient * s / lever``; a
+        distance law (s is a force) applies a moment ``coefficient * s * lever``. ``None`` where
+        the dimensions agree (``value = coefficient * s``).
+    """
+
+    body: str = ""
+    action: str = "force"
+    direction: tuple = field(default=(1.0, 0.0, 0.0), metadata=dimensionless())
+    frame: str = "body"
+    point: tuple = field(default=(0.0, 0.0, 0.0), metadata=dim(LENGTH))
+    coefficient: float = field(default=1.0, metadata=dimensionless())
+    lever: float | None = field(default=None, metadata=dim(LENGTH))
+
+    def __post_init__(self) -> None:
+        check_name("body", self.body)
+        if self.action not in ACTIONS:
+            raise SceneError("action", self.action, f"must be one of {ACTIONS}")
+        direction = check_finite_vector("direction", self.direction, 3)
+        if not any(direction):
+            raise SceneError("direction", self.direction, "must be a non-zero vector")
+        object.__setattr__(self, "direction", direction)
+        _check_frame(self.frame)
+        object.__setattr__(self, "point", check_finite_vector("point", self.point, 3))
+        if self.action == "moment" and any(self.point):
+            raise SceneError("point", self.point, "a moment has no point of application "
+                             "(leave it at the origin)")
+        check_finite("coefficient", self.coefficient)
+        if self.lever is not None:
+            check_positive("lever", self.lever)
+
+    def unit_direction(self) -> tuple[float, float, float]:
+        """``direction`` normalised (in ``frame`` axes)."""
+        norm = math.sqrt(sum(c * c for c in self.direction))
+        return tuple(c / norm for c in self.direction)  # type: ignore[return-value]
+
+    def gain(self, scalar_is_moment: bool) -> float:
+        """Factor from the law's scalar to this application's force [F] or moment [F L]."""
+        if self.lever is None:
+            return self.coefficient
+        if scalar_is_moment:
+            return self.coefficient / self.lever
+        return self.coefficient * self.lever
+
+
+def _applications(value: Any, scalar_is_moment: bool) -> tuple[LoadApplication, ...]:
+    """Check (and build from plain dicts) the applications of a law load."""
+    if isinstance(value, str | dict) or not hasattr(value, "__iter__"):
+        raise SceneError("applications", value, "must be a list of applications")
+    items = list(value)
+    if not items:
+        raise SceneError("applications", value, "a law load needs at least one application")
+    out = []
+    names = [f.name for f in dataclasses.fields(LoadApplication)]
+    for index, item in enumerate(items):
+        path = f"applications[{index}]"
+        try:
+            if isinstance(item, dict):
+                unknown = sorted(set(item) - set(names))
+                if unknown:
+                    raise SceneError(unknown[0], item[unknown[0]],
+                                     f"unknown field of an application (fields: {names})")
+                item = LoadApplication(**item)
+            if not isinstance(item, LoadApplication):
+                raise SceneError("", item, "must be a LoadApplication or a table")
+            converts = (item.action == "force") == scalar_is_moment
+            if converts and item.lever is None:
+                law = "an angle law (a moment)" if scalar_is_moment else "a distance law (a force)"
+                raise SceneError("lever", None, f"a {item.action} driven by {law} needs a lever")
+            if not converts and item.lever is not None:
+                raise SceneError("lever", item.lever, f"a {item.action} of this law takes no "
+                                 "lever (the dimensions already agree)")
+        except SceneError as error:
+            raise error.within(path) from None
+        out.append(item)
+    return tuple(out)
+
+
+@dataclass(frozen=True)
+class AngleLawLoad(Load):
+    """A law of body angles about a world axis, applied through ``applications``.
+
+    ``s = stiffness * (offset + sum_i angle_coefficients[i] * theta(bodies[i]))`` [F L], where
+    theta(b) is the ABSOLUTE rotation of body b about the world ``axis``: the twist angle
+    2 atan2(q . axis, q_w) of its orientation quaternion q (q_w >= 0), i.e. its rotation from
+    the body frame's reference orientation (1, 0, 0, 0). The offset carries the law's reference
+    (a rest angle, a preload). Each application turns ``s`` into a force (``coefficient * s /
+    lever``) or a moment (``coefficient * s``); see :class:`LoadApplication`.
+    """
+
+    kind: ClassVar[str] = "angle_law"
+    axis: tuple = field(default=(0.0, 0.0, 1.0), metadata=dimensionless())
+    stiffness: float = field(default=0.0, metadata=dim(TORSIONAL_STIFFNESS))
+    offset: float = field(default=0.0, metadata=dimensionless())
+    angle_bodies: tuple = ()
+    angle_coefficients: tuple = field(default=(), metadata=dimensionless())
+    applications: tuple = ()
+
+    def _validate(self) -> None:
+        self._set("axis", check_unit_axis("axis", self.axis))
+        check_non_negative("stiffness", self.stiffness)
+        check_finite("offset", self.offset)
+        bodies = tuple(self.angle_bodies) if not isinstance(self.angle_bodies, str) else None
+        if not bodies:
+            raise SceneError("angle_bodies", self.angle_bodies, "must list at least one body")
+        for index, body in enumerate(bodies):
+            check_name(f"angle_bodies[{index}]", body)
+        if len(set(bodies)) != len(bodies):
+            raise SceneError("angle_bodies", self.angle_bodies, "a body is listed twice")
+        self._set("angle_bodies", bodies)
+        self._set("angle_coefficients", check_finite_vector(
+            "angle_coefficients", self.angle_coefficients, len(bodies)))
+        self._set("applications", _applications(self.applications, scalar_is_moment=True))
+
+    @property
+    def bodies(self) -> tuple[str, ...]:
+        names = list(self.angle_bodies)
+        names += [a.body for a in self.applications if a.body not in names]
+        return tuple(names)
+
+
+@dataclass(frozen=True)
+class DistanceLawLoad(Load):
+    """A law of the distance L between ``point_a`` of ``body_a`` and ``point_b`` of ``body_b``
+    (body frames [L]), applied through ``applications``.
+
+    ``s = stiffness * (rest_length - L)`` [F]: positive when the points are closer than the rest
+    length (a compressed spring pushes). Each application turns ``s`` into a force
+    (``coefficient * s``, in any direction: not necessarily along the line of the points) or a
+    moment (``coefficient * s * lever``); see :class:`LoadApplication`.
+    """
+
+    kind: ClassVar[str] = "distance_law"
+    body_a: str = ""
+    point_a: tuple = field(default=(0.0, 0.0, 0.0), metadata=dim(LENGTH))
+    body_b: str = ""
+    point_b: tuple = field(default=(0.0, 0.0, 0.0), metadata=dim(LENGTH))
+    stiffness: float = field(default=0.0, metadata=dim(LINEAR_STIFFNESS))
+    rest_length: float = field(default=0.0, metadata=dim(LENGTH))
+    applications: tuple = ()
+
+    def _validate(self) -> None:
+        _check_two_bodies(self.body_a, self.body_b)
+        self._set("point_a", check_finite_vector("point_a", self.point_a, 3))
+        self._set("point_b", check_finite_vector("point_b", self.point_b, 3))
+        check_non_negative("stiffness", self.stiffness)
+        check_non_negative("rest_length", self.rest_length)
+        self._set("applications", _applications(self.applications, scalar_is_moment=False))
+
+    @property
+    def bodies(self) -> tuple[str, ...]:
+        names = [self.body_a, self.body_b]
+        names += [a.body for a in self.applications if a.body not in names]
+        return tuple(names)
+
+
 LOAD_TYPES: dict[str, type[Load]] = {
-    cls.kind: cls for cls in (LinearSpringDamper, TorsionalSpringDamper, PointForce, Moment)
+    cls.kind: cls for cls in (LinearSpringDamper, TorsionalSpringDamper, PointForce, Moment,
+                              AngleLawLoad, DistanceLawLoad)
 }
 
 

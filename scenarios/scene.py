@@ -146,6 +146,11 @@ class Scene:
                 if hasattr(load, attribute):
                     self._body_or_error(f"loads[{load.name!r}].{attribute}",
                                         getattr(load, attribute))
+            for index, name in enumerate(getattr(load, "angle_bodies", ())):
+                self._body_or_error(f"loads[{load.name!r}].angle_bodies[{index}]", name)
+            for index, application in enumerate(getattr(load, "applications", ())):
+                self._body_or_error(f"loads[{load.name!r}].applications[{index}].body",
+                                    application.body)
         driven = set()
         for driver in self.drivers:
             body = self._body_or_error(f"drivers[{driver.name!r}].body", driver.body)
@@ -230,7 +235,8 @@ class Scene:
         Vocabulary: ``gravity``, ``contacts``, ``friction``, ``restitution``, ``shape:<kind>``,
         ``pair:<kind>-<kind>`` (sorted), ``ideal_joints``, ``joint:<kind>``, ``closed_loop``,
         ``clearance_joints``, ``rings``, ``arcs``, ``springs``, ``torsional_springs``,
-        ``point_forces``, ``moments``, ``time_switched_loads``, ``drivers``, ``fixed_bodies``.
+        ``point_forces``, ``moments``, ``angle_law_loads``, ``distance_law_loads``,
+        ``time_switched_loads``, ``drivers``, ``fixed_bodies``.
         """
         features: set[str] = set()
         if any(self.gravity):
@@ -267,6 +273,7 @@ class Scene:
             features.add({
                 "linear_spring": "springs", "torsional_spring": "torsional_springs",
                 "point_force": "point_forces", "moment": "moments",
+                "angle_law": "angle_law_loads", "distance_law": "distance_law_loads",
             }[load.kind])
             if isinstance(load, PointForce | Moment) and (
                 load.start_time > 0 or load.end_time is not None

@@ -15,6 +15,13 @@ Circle    the circle of ``radius`` in the shape's xy-plane, centred at the origi
           ring edge, as the C-60 CAD draws rings).
 Arc       the part of that circle between angles ``start_angle`` and ``end_angle`` (radians,
           measured from +x about +z, ``start_angle < end_angle <= start_angle + 2 pi``).
+Rectangle a bounded plane face: the half-space z <= 0 as for Plane, but a contact exists only
+          where its point on the face lies in |x| <= ``half_extents[0]``, |y| <=
+          ``half_extents[1]`` (a CAD plane face; no edge contact is modelled beyond it).
+Disc      the same bounded by the circle x^2 + y^2 <= ``radius``^2 (a round plane face).
+Bore      a concave cylindrical surface (a hole: material OUTSIDE the radius), axis along z,
+          ``radius``, bounded to |z| <= ``half_length`` and to the angles ``start_angle`` ..
+          ``end_angle`` about +z from +x (a full bore by default; a concave CAD patch else).
 ========  =====================================================================================
 
 Validation of the numbers (finite, positive) happens at construction; every error names the field
@@ -133,20 +140,60 @@ class Arc(Shape):
 
     def _check_parameters(self) -> None:
         object.__setattr__(self, "radius", check_positive("radius", self.radius))
-        start = check_finite_vector("start_angle", (self.start_angle,), 1)[0]
-        end = check_finite_vector("end_angle", (self.end_angle,), 1)[0]
-        if not start < end <= start + 2.0 * math.pi:
-            raise SceneError(
-                "end_angle",
-                end,
-                "must satisfy start_angle < end_angle <= start_angle + 2 pi "
-                f"(start_angle = {start})",
-            )
-        object.__setattr__(self, "start_angle", start)
-        object.__setattr__(self, "end_angle", end)
+        _check_angle_range(self)
+
+
+def _check_angle_range(shape: Shape) -> None:
+    start = check_finite_vector("start_angle", (shape.start_angle,), 1)[0]
+    end = check_finite_vector("end_angle", (shape.end_angle,), 1)[0]
+    if not start < end <= start + 2.0 * math.pi:
+        raise SceneError(
+            "end_angle",
+            end,
+            "must satisfy start_angle < end_angle <= start_angle + 2 pi "
+            f"(start_angle = {start})",
+        )
+    object.__setattr__(shape, "start_angle", start)
+    object.__setattr__(shape, "end_angle", end)
+
+
+@dataclass(frozen=True)
+class Rectangle(Shape):
+    kind: ClassVar[str] = "rectangle"
+    half_extents: tuple[float, float] = field(default=(0.5, 0.5), metadata=dim(LENGTH))
+
+    def _check_parameters(self) -> None:
+        values = check_finite_vector("half_extents", self.half_extents, 2)
+        for axis, value in zip("xy", values, strict=True):
+            check_positive(f"half_extents.{axis}", value)
+        object.__setattr__(self, "half_extents", values)
+
+
+@dataclass(frozen=True)
+class Disc(Shape):
+    kind: ClassVar[str] = "disc"
+    radius: float = field(default=0.5, metadata=dim(LENGTH))
+
+    def _check_parameters(self) -> None:
+        object.__setattr__(self, "radius", check_positive("radius", self.radius))
+
+
+@dataclass(frozen=True)
+class Bore(Shape):
+    kind: ClassVar[str] = "bore"
+    radius: float = field(default=0.1, metadata=dim(LENGTH))
+    half_length: float = field(default=0.5, metadata=dim(LENGTH))
+    start_angle: float = field(default=0.0, metadata=dimensionless())
+    end_angle: float = field(default=2.0 * math.pi, metadata=dimensionless())
+
+    def _check_parameters(self) -> None:
+        object.__setattr__(self, "radius", check_positive("radius", self.radius))
+        object.__setattr__(self, "half_length", check_positive("half_length", self.half_length))
+        _check_angle_range(self)
 
 
 #: Every shape class by its ``kind`` string (the ``kind`` key of the dict/TOML form).
 SHAPE_TYPES: dict[str, type[Shape]] = {
-    cls.kind: cls for cls in (Sphere, Box, Capsule, Cylinder, Plane, Circle, Arc)
+    cls.kind: cls
+    for cls in (Sphere, Box, Capsule, Cylinder, Plane, Circle, Arc, Rectangle, Disc, Bore)
 }

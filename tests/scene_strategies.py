@@ -10,9 +10,27 @@ from clearbench.scenarios.bodies import Body, Motion
 from clearbench.scenarios.contacts import ContactPair
 from clearbench.scenarios.drivers import Driver
 from clearbench.scenarios.joints import ClearanceRevoluteJoint, RevoluteJoint, SphericalJoint
-from clearbench.scenarios.loads import LinearSpringDamper, Moment, PointForce
+from clearbench.scenarios.loads import (
+    AngleLawLoad,
+    DistanceLawLoad,
+    LinearSpringDamper,
+    LoadApplication,
+    Moment,
+    PointForce,
+)
 from clearbench.scenarios.scene import Scene
-from clearbench.scenarios.shapes import Arc, Box, Capsule, Circle, Cylinder, Plane, Sphere
+from clearbench.scenarios.shapes import (
+    Arc,
+    Bore,
+    Box,
+    Capsule,
+    Circle,
+    Cylinder,
+    Disc,
+    Plane,
+    Rectangle,
+    Sphere,
+)
 from clearbench.scenarios.units import UnitSystem
 
 # Values below 1e-200 are excluded: rescaling to um-mg-us multiplies some by 1e-6, and values
@@ -67,6 +85,11 @@ def shapes(name: str):
         st.builds(Circle, name=st.just(name), radius=positive, **placement),
         st.builds(Arc, name=st.just(name), radius=positive, start_angle=st.just(0.25),
                   end_angle=st.floats(0.5, 6.0), **placement),
+        st.builds(Rectangle, name=st.just(name), half_extents=st.tuples(positive, positive),
+                  **placement),
+        st.builds(Disc, name=st.just(name), radius=positive, **placement),
+        st.builds(Bore, name=st.just(name), radius=positive, half_length=positive,
+                  start_angle=st.just(-1.0), end_angle=st.floats(0.0, 5.0), **placement),
     )
 
 
@@ -111,6 +134,19 @@ def scenes(draw):
         PointForce("push", body="body1", force=draw(vector3), frame="body", start_time=0.0,
                    end_time=draw(st.one_of(st.none(), positive))),
         Moment("twist", body="body1", moment=draw(vector3), start_time=draw(positive)),
+        AngleLawLoad("angle_law", axis=(0.0, 0.0, 1.0), stiffness=draw(positive),
+                     offset=draw(finite), angle_bodies=("body1",),
+                     angle_coefficients=(draw(finite),),
+                     applications=(
+                         LoadApplication("body1", "force", (1.0, 2.0, 0.5), "body",
+                                         draw(vector3), draw(finite), draw(positive)),
+                         LoadApplication("ground", "moment", (0.0, 0.0, 1.0), "world",
+                                         coefficient=draw(finite)))),
+        DistanceLawLoad("distance_law", body_a="ground", point_a=draw(vector3), body_b="body1",
+                        point_b=draw(vector3), stiffness=draw(positive),
+                        rest_length=draw(positive),
+                        applications=(LoadApplication("body1", "moment", (0.0, 1.0, 0.0),
+                                                      "body", lever=draw(positive)),)),
     ]
     drivers = []
     if draw(st.booleans()):

@@ -225,7 +225,14 @@ def random_parameters(kind, rng):
         return params()
     if kind == G.CIRCLE:
         return params(rng.uniform(0.6, 1.2))
+    if kind == G.RECTANGLE:
+        return params(*rng.uniform(1.0, 3.0, size=2))
+    if kind == G.DISC:
+        return params(rng.uniform(1.0, 3.0))
     start = rng.uniform(-math.pi, math.pi)
+    if kind == G.BORE:
+        return params(rng.uniform(1.5, 2.5), rng.uniform(0.5, 2.0), start,
+                      start + rng.uniform(1.0, 2 * math.pi))
     return params(rng.uniform(0.6, 1.2), start, start + rng.uniform(0.3, 2 * math.pi))
 
 

@@ -1,0 +1,456 @@
+"""The C-60 validation table: our runs against the published figures (Akhadkar, Acary,
+Brogliato 2018, Sections 4.2 and 5), with the differences reported, never tuned away.
+
+:func:`validate` runs the scenes it needs with the reference engine (each run cached as a
+trajectory file keyed by the scene's content hash), computes the figures and returns a
+:class:`ValidationReport`; :func:`write_markdown` and :func:`write_figures` render it.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from clearbench.adapters.base import RunSettings
+from clearbench.adapters.reference import create
+from clearbench.adapters.trajectory import Trajectory
+from clearbench.scenarios import c60_model as model
+from clearbench.scenarios.registry import get_scene
+from clearbench.scenarios.scene import Scene
+
+from . import c60_analysis as analysis
+from . import metrics
+
+logger = logging.getLogger(__name__)
+
+#: Relative difference above which the report says what we believe causes it.
+EXPLAIN_ABOVE = 0.10
+#: A bench test at a raised probe speed stands for the study's 0.5 mm/s when a run at half the
+#: speed gives the same curve within these: 2 % of its forces (the paper's simulation and
+#: measurement differ by 2 % on FC-1) and 0.01 mm of its distances (2 % of the 0.44 mm trip).
+SPEED_FORCE_TOLERANCE = 0.02
+SPEED_DISTANCE_TOLERANCE = 0.01
+
+
+@dataclass(frozen=True)
+class Run:
+    """One cached run: the scene, its trajectory, and how long stepping took [s]."""
+
+    key: str
+    scene: Scene
+    trajectory: Trajectory
+
+    @property
+    def unconverged(self) -> list:
+        return list(self.trajectory.metadata.get("unconverged_steps", []))
+
+    @property
+    def penetration(self) -> float:
+        depth = metrics.penetration(self.scene, self.trajectory)
+        return float(depth.max()) if depth.size else 0.0
+
+
+def run_scene(key: str, name: str, parameters: dict, cache: Path | None, preset: str = "default",
+              record_every: int = 10) -> Run:
+    """Run a registered scene with the reference engine, or read it back from ``cache``."""
+    scene = get_scene(name, **parameters)
+    path = cache / f"{key}.npz" if cache is not None else None
+    if path is not None and path.exists():
+        trajectory = Trajectory.load(path)
+        if trajectory.scene_hash == scene.content_hash and trajectory.preset == preset:
+            logger.info("%s: read from %s", key, path)
+            return Run(key, scene, trajectory)
+    logger.info("%s: running %s %s (%s steps)", key, name, parameters,
+                round(scene.horizon / scene.time_step))
+    tick = time.perf_counter()
+    trajectory = create(preset).run(scene, RunSettings(record_every=record_every))
+    logger.info("%s: %.0f s", key, time.perf_counter() - tick)
+    if path is not None:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        trajectory.save(path)
+    return Run(key, scene, trajectory)
+
+
+@dataclass(frozen=True)
+class Row:
+    """One line of the table: our figure beside the paper's (NaN where it gives none)."""
+
+    quantity: str
+    unit: str
+    ours: float
+    paper_simulated: float = math.nan
+    paper_measured: float = math.nan
+    note: str = ""
+
+    def difference(self) -> float:
+        """Relative difference to the measured value, else to the paper's simulated one."""
+        reference = self.paper_measured if not math.isnan(self.paper_measured) \
+            else self.paper_simulated
+        return (self.ours - reference) / abs(reference) if reference else math.nan
+
+
+@dataclass
+class ValidationReport:
+    rows: list[Row] = field(default_factory=list)
+    runs: dict[str, Run] = field(default_factory=dict)
+    curves: dict = field(default_factory=dict)
+    findings: list[str] = field(default_factory=list)
+
+
+def _paper() -> dict:
+    return model.load_model()["paper"]
+
+
+def validate(cache: Path | None = None, preset: str = "default", speed_check: bool = True,
+             sensitivity: bool = True) -> ValidationReport:
+    """Run what the table needs and fill it (see the module docstring)."""
+    report = ValidationReport()
+    paper = _paper()
+    experiments = paper["experiments"]
+    fcs = paper["functional_conditions"]
+    prototype = model.prototype_clearances()
+
+    def run(key, name, parameters, record_every=10):
+        report.runs[key] = run_scene(key, name, parameters, cache, preset, record_every)
+        return report.runs[key]
+
+    # Equilibrium in the ON pose: nominal (the sheet's) and prototype clearances.
+    nominal = run("on_nominal", "c60-on", {})
+    settled = analysis.settled_outputs(nominal.scene, nominal.trajectory)
+    on_proto = run("on_prototype", "c60-on", {"clearances": prototype})
+    settled_proto = analysis.settled_outputs(on_proto.scene, on_proto.trajectory)
+    force = experiments["contact_force_at_equilibrium_N"]
+    report.rows.append(Row(
+        "FC-1, C7 force at equilibrium, prototype clearances (c60-on)", "N",
+        settled_proto["FC1_contact_force"], force["simulated"], force["measured"]))
+    report.rows.append(Row(
+        "FC-1, nominal clearances (c60-on) vs Monte Carlo mean", "N",
+        settled["FC1_contact_force"], fcs["FC1"]["mean"],
+        note=f"Monte Carlo range {fcs['FC1']['range'][0]}-{fcs['FC1']['range'][1]} N"))
+    for fc, key in (("FC-2", "FC2"), ("FC-3", "FC3"), ("FC-4", "FC4"), ("FC-5", "FC5"),
+                    ("FC-6", "FC6")):
+        output, description = model.FUNCTIONAL_CONDITIONS[fc]
+        report.rows.append(Row(f"{fc}, {output} (c60-on, nominal) vs Monte Carlo mean", "mm",
+                               settled[output], fcs[key]["mean"],
+                               note=f"sigma {fcs[key]['sigma']} mm; {description}"))
+    if sensitivity:
+        for key, parameters, label in (
+                ("on_design_arm", {"handle_spring_arm": "design"},
+                 "handle spring at its design arm"),
+                ("on_preload_0.9599", {"contact_spring_preload": 0.9599},
+                 "contact spring preload 0.9599 rad (the source's commented alternative)")):
+            variant = run(key, "c60-on", parameters)
+            value = analysis.settled_outputs(variant.scene, variant.trajectory)
+            report.rows.append(Row(f"FC-1 with {label}, nominal clearances", "N",
+                                   value["FC1_contact_force"], fcs["FC1"]["mean"],
+                                   note="sensitivity, not the model"))
+
+    # The magnetic trip.
+    trip = run("trip", "c60-trip", {})
+    events = analysis.trip_events(trip.scene, trip.trajectory)
+    report.curves["trip_events"] = events
+    report.rows.append(Row("c60-trip: plunger strikes the tripping bar", "ms", events.strike,
+                           note="no published figure"))
+    report.rows.append(Row("c60-trip: latch released (C4, C5 unloaded)", "ms", events.release,
+                           note="no published figure"))
+    report.rows.append(Row("c60-trip: contacts open (C7 gap > 0.1 mm)", "ms",
+                           events.opening, note=f"no published figure; {events.chatter} C7 "
+                           f"re-closures between release and opening; smallest C7 gap in the "
+                           f"1 ms after: {events.gap_after:.3f} mm"))
+    report.findings.append(_trip_failure(trip))
+
+    # Bench: contact force vs displacement (prototype clearances).
+    contact = run("contact_force_test", "c60-contact-force-test", {}, record_every=20)
+    curve = analysis.contact_force_curve(contact.scene, contact.trajectory)
+    report.curves["contact_force"] = {"v": curve}
+    report.rows.append(Row("Contact-force test: force at the reference position", "N",
+                           curve.equilibrium_force, force["simulated"], force["measured"]))
+    report.rows.append(Row("Contact-force test: loaded travel to the reference", "mm",
+                           curve.loaded_travel,
+                           paper_measured=experiments["contact_test_total_displacement_mm"]))
+    # Bench: tripping force vs displacement (prototype clearances).
+    trip_test = run("trip_force_test", "c60-trip-force-test", {}, record_every=20)
+    trip_curve = analysis.trip_force_curve(trip_test.scene, trip_test.trajectory)
+    report.curves["trip_force"] = {"v": trip_curve}
+    peak = experiments["trip_test_peak_force_N"]
+    distance = experiments["trip_test_total_distance_mm"]
+    report.rows.append(Row("Trip test: peak force", "N", trip_curve.peak_force,
+                           peak["simulated"], peak["measured"]))
+    report.rows.append(Row("Trip test: displacement at the peak", "mm",
+                           trip_curve.peak_displacement,
+                           paper_measured=experiments["trip_test_peak_at_mm"]))
+    report.rows.append(Row("Trip test: total trip distance", "mm", trip_curve.trip_distance,
+                           distance["simulated"], distance["measured"]))
+    report.findings.append(_first_contact_phase(trip_test))
+    if sensitivity:
+        design = run("trip_force_test_design_arm", "c60-trip-force-test",
+                     {"handle_spring_arm": "design"}, record_every=20)
+        design_curve = analysis.trip_force_curve(design.scene, design.trajectory)
+        report.curves["trip_force"]["design arm"] = design_curve
+        report.rows.append(Row("Trip test: peak force, handle spring at its design arm", "N",
+                               design_curve.peak_force, peak["simulated"], peak["measured"],
+                               note="sensitivity, not the model"))
+        report.rows.append(Row("Trip test: trip distance, handle spring at its design arm",
+                               "mm", design_curve.trip_distance, distance["simulated"],
+                               distance["measured"], note="sensitivity, not the model"))
+    report.findings.append(explain_contact_force(nominal))
+    if speed_check:
+        base_speed = _probe_speed(trip_test.scene)
+        slow = run("trip_force_test_half_speed", "c60-trip-force-test",
+                   {"probe_speed": 0.5 * base_speed}, record_every=40)
+        slow_curve = analysis.trip_force_curve(slow.scene, slow.trajectory)
+        report.curves["trip_force"]["v/2"] = slow_curve
+        same = (abs(trip_curve.peak_force - slow_curve.peak_force)
+                <= SPEED_FORCE_TOLERANCE * slow_curve.peak_force
+                and abs(trip_curve.trip_distance - slow_curve.trip_distance)
+                <= SPEED_DISTANCE_TOLERANCE)
+        report.findings.append(
+            f"Trip test at {base_speed} mm/ms and at half that speed: peak force "
+            f"{trip_curve.peak_force:.4f} / {slow_curve.peak_force:.4f} N, peak at "
+            f"{trip_curve.peak_displacement:.4f} / {slow_curve.peak_displacement:.4f} mm, trip "
+            f"distance {trip_curve.trip_distance:.4f} / {slow_curve.trip_distance:.4f} mm: "
+            + ("the same curve within" if same else "NOT the same curve within")
+            + f" the stated tolerance ({100 * SPEED_FORCE_TOLERANCE:.0f} % of the peak force, "
+            f"{SPEED_DISTANCE_TOLERANCE} mm of trip distance).")
+        contact_speed = _probe_speed(contact.scene)
+        slow = run("contact_force_test_half_speed", "c60-contact-force-test",
+                   {"probe_speed": 0.5 * contact_speed}, record_every=40)
+        slow_contact = analysis.contact_force_curve(slow.scene, slow.trajectory)
+        report.curves["contact_force"]["v/2"] = slow_contact
+        same = (abs(curve.equilibrium_force - slow_contact.equilibrium_force)
+                <= SPEED_FORCE_TOLERANCE * slow_contact.equilibrium_force
+                and abs(curve.loaded_travel - slow_contact.loaded_travel)
+                <= SPEED_DISTANCE_TOLERANCE)
+        report.findings.append(
+            f"Contact-force test at {contact_speed} and {0.5 * contact_speed} mm/ms: force at "
+            f"the reference {curve.equilibrium_force:.4f} / "
+            f"{slow_contact.equilibrium_force:.4f} N, loaded travel {curve.loaded_travel:.4f} / "
+            f"{slow_contact.loaded_travel:.4f} mm: "
+            + ("the same curve within" if same else "NOT the same curve within")
+            + " the stated tolerance.")
+    return report
+
+
+def _probe_speed(scene: Scene) -> float:
+    """Pushing speed of a bench scene's probe [mm/ms]."""
+    driver = next(d for d in scene.drivers if d.body == "probe"
+                  and d.component in ("x", "y") and len(d.times) > 1)
+    if driver.quantity == "velocity":
+        return float(driver.values[-1])
+    times, values = driver.times, driver.values
+    return float((values[2] - values[1]) / (times[2] - times[1]))
+
+
+def _first_contact_phase(run: Run) -> str:
+    """Where the trip test's probe first touched the pin: in the slow phase, as it must."""
+    values = metrics.output_values(run.scene, run.trajectory)
+    touching = np.nonzero(values["probe_force"] > analysis.FORCE_THRESHOLD)[0]
+    driver = next(d for d in run.scene.drivers if d.name == "probe_y")
+    slow_from = driver.times[3]
+    if touching.size == 0:
+        return "Trip test: the probe never touched the pin."
+    first = float(run.trajectory.times[touching[0]])
+    phase = "in the slow phase" if first >= slow_from else "BEFORE the slow phase"
+    return (f"Trip test: first probe contact at {first:.3f} ms, {phase} (slow from "
+            f"{slow_from:.3f} ms).")
+
+
+def explain_contact_force(run: Run) -> str:
+    """Why FC-1 is what it is: the moving contact's moment balance about the needle, with the
+    figures of the run's last sample."""
+    from clearbench.ref_solver.forces import twist_angle
+    from clearbench.scenarios.quaternion import quat_to_matrix
+
+    scene, trajectory = run.scene, run.trajectory
+    z = np.array([0.0, 0.0, 1.0])
+    law = next(load for load in scene.loads if load.name == "contact_pressure_spring")
+    angles = {}
+    for name in ("moving_contact", "plate"):
+        q = trajectory.orientations[-1, scene.body_index(name)]
+        angles[name] = twist_angle(quat_to_matrix(q / np.linalg.norm(q)), z)
+    moment = law.stiffness * (law.offset + angles["moving_contact"] - angles["plate"])
+    index = scene.body_index("moving_contact")
+    rotation = quat_to_matrix(trajectory.orientations[-1, index])
+    centre = trajectory.positions[-1, index] + rotation @ np.asarray(
+        scene.body("moving_contact").center_of_mass)
+    application = law.applications[2]
+    direction = rotation @ np.asarray(application.unit_direction())
+    force = moment * application.gain(True) * direction
+    needle = trajectory.positions[-1, scene.body_index("needle")]
+    law_moment = float(np.cross(centre - needle, force)[2])
+    fc1 = float(trajectory.contact_normal_force[-1, trajectory.contact_index(model.C7)])
+    lever = abs(law_moment) / fc1 if fc1 > 0 else math.nan
+    return (f"FC-1 follows from the moving contact's moment balance about the needle: the "
+            f"contact-pressure law gives M = {moment:.1f} N mm at equilibrium, its force "
+            f"M/6.06 along the moving contact's body (0.6, -1.1, -0.01) has a moment of "
+            f"{abs(law_moment):.1f} N mm about the needle axis, which C7 balances at a lever of "
+            f"{lever:.2f} mm: FC-1 = {fc1:.2f} N (joint friction and the contact's tangential "
+            f"force make up the rest). About 15 N would need M near "
+            f"{15.0 * lever * abs(moment / law_moment):.0f} N mm with these levers.")
+
+
+#: What the source does that a reader of the paper would not expect (all checked in the source
+#: and reproduced by the scene, see clearbench.scenarios.c60_model).
+MODEL_NOTES = (
+    "Loads are the source's plugin laws, with their physical signs (Siconos subtracts the "
+    "'internal' forces the plugin returns negated); the bar's settling moment is therefore "
+    "-15 N mm about z for t < 1 ms (its function returns +15 un-negated).",
+    "Handle spring: the source takes its initial angle unsigned (2 acos(q0_w) = +0.3316 rad "
+    "for a -0.3316 rad pose), so the law is 3.82 (1.99 + 0.3316 - theta) N mm; and it takes the "
+    "moment about the centre of mass with the arm R (P0 - z0), where Siconos passes the "
+    "initial centre-of-mass position in world as z0: the force acts 21 mm from the pivot "
+    "(27.1 N mm about it instead of the law's 10.1). The default scene reproduces this; "
+    "`handle_spring_arm='design'` applies the evident intent.",
+    "Contact-pressure spring: M = 244.46 (theta_mc - theta_plate + 76.54 deg + 0.49 rad) "
+    "N mm in this version of the source; its comment lists 0.6547 and 0.9599 rad as other "
+    "preloads.",
+    "Needle: the paper's mass and inertia (the source has placeholders); its centre of mass "
+    "(0, 0, 5) in the body frame lies 5 mm off its axis in both the source and the paper.",
+    "Joint J1's top ring has 0.041 mm radial clearance with the sheet's offsets (0.52 mm CAD "
+    "gap), twice the other joints' 0.021 mm; the needle's S3 bearings 0.006 mm.",
+    "Bounded faces: TRIP_1 and C3 ON 1, 2 have their nearest point beyond the face (no "
+    "contact candidate; OpenCASCADE measures to the face's edge, 0.86 and 3.8 mm in the ON "
+    "pose). Every other ON-pose gap agrees with OpenCASCADE within the CAD's B-spline residual "
+    "(1.2e-4 mm).",
+)
+
+
+def _fmt(value: float, digits: int = 3) -> str:
+    return "-" if value is None or (isinstance(value, float) and math.isnan(value)) \
+        else f"{value:.{digits}f}"
+
+
+def write_markdown(report: ValidationReport, path: Path, figures: dict[str, Path],
+                   preset: str) -> None:
+    """The table, the findings and the runs' statistics as Markdown."""
+    lines = [
+        "# C-60 validation: the reference engine against the published figures",
+        "",
+        "Generated by `clearbench c60 validate` (reference engine, preset "
+        f"`{preset}`, h = 1e-3 ms as the source). Paper: Akhadkar, Acary, Brogliato, "
+        "Multibody System Dynamics 42(3), 2018 (seed document), Sections 4.2 and 5. "
+        "Differences are relative to the measured value where there is one, else to the "
+        "paper's simulated value; nothing is tuned to them.",
+        "",
+        "| quantity | unit | ours | paper, simulated | paper, measured | difference |",
+        "|---|---|---|---|---|---|",
+    ]
+    for row in report.rows:
+        difference = row.difference()
+        text = "-" if math.isnan(difference) else f"{100 * difference:+.1f} %"
+        note = f" ({row.note})" if row.note else ""
+        lines.append(f"| {row.quantity}{note} | {row.unit} | {_fmt(row.ours)} | "
+                     f"{_fmt(row.paper_simulated)} | {_fmt(row.paper_measured)} | {text} |")
+    lines += ["", "## Functional conditions: how each is computed", ""]
+    for fc, (output, description) in model.FUNCTIONAL_CONDITIONS.items():
+        lines.append(f"- {fc}: output `{output}`, {description}; averaged over the last "
+                     "millisecond of c60-on.")
+    lines += ["- The paper's Monte Carlo means pair oddly with the measurement pairs' names "
+              "(FC-2 10.72 mm is near the lamage axis x, FC-4 10.60 mm near the pin x): "
+              "both readings are in the table's figures.", ""]
+    lines += ["## Model notes", ""]
+    lines += [f"- {note}" for note in MODEL_NOTES]
+    lines += ["", "## Findings", ""]
+    lines += [f"- {finding}" for finding in report.findings]
+    large = [row for row in report.rows if not math.isnan(row.difference())
+             and abs(row.difference()) > EXPLAIN_ABOVE and "sensitivity" not in row.note]
+    if large:
+        lines += ["", "## Differences above 10 %", ""]
+        lines += [f"- {row.quantity}: {100 * row.difference():+.1f} %." for row in large]
+    lines += ["", "## Runs", "",
+              "| run | scene | steps | stepping [s] | unconverged steps | max penetration [mm] |",
+              "|---|---|---|---|---|---|"]
+    for key, run in report.runs.items():
+        unconverged = run.unconverged
+        listed = ", ".join(str(k) for k in unconverged[:5]) + (" ..." if len(unconverged) > 5
+                                                              else "")
+        lines.append(f"| {key} | {run.scene.name} | {run.trajectory.steps} | "
+                     f"{run.trajectory.stepping_seconds:.0f} | {len(unconverged)}"
+                     f"{' (' + listed + ')' if unconverged else ''} | {run.penetration:.2e} |")
+    if figures:
+        lines += ["", "## Figures", ""]
+        for title, figure in figures.items():
+            relative = Path("figures") / figure.name
+            lines.append(f"![{title}]({relative.as_posix()})")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text("\n".join(lines) + "\n")
+
+
+def write_figures(report: ValidationReport, directory: Path) -> dict[str, Path]:
+    """Force-displacement figures of the bench tests (PNG), with the paper's key points."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    directory.mkdir(parents=True, exist_ok=True)
+    experiments = _paper()["experiments"]
+    out = {}
+    curves = report.curves.get("trip_force", {})
+    if curves:
+        figure, axes = plt.subplots(figsize=(6.5, 4.2))
+        for label, curve in curves.items():
+            axes.plot(curve.displacement, curve.force, label=f"ours, {label}")
+        peak = experiments["trip_test_peak_force_N"]
+        distance = experiments["trip_test_total_distance_mm"]
+        axes.plot([experiments["trip_test_peak_at_mm"]], [peak["measured"]], "ks",
+                  label="paper, measured peak")
+        axes.axvline(distance["measured"], color="k", ls=":", label="paper, measured trip")
+        axes.axvline(distance["simulated"], color="grey", ls="--",
+                     label="paper, simulated trip")
+        axes.axhline(peak["simulated"], color="grey", ls="-.", label="paper, simulated peak")
+        axes.set_xlabel("probe displacement since first contact [mm]")
+        axes.set_ylabel("probe force [N]")
+        axes.set_title("C-60 trip test, pin side (prototype clearances)")
+        axes.legend(fontsize=7)
+        path = directory / "c60_trip_force.png"
+        figure.tight_layout()
+        figure.savefig(path, dpi=110)
+        plt.close(figure)
+        out["Trip force vs displacement"] = path
+    curves = report.curves.get("contact_force", {})
+    if curves:
+        figure, axes = plt.subplots(figsize=(6.5, 4.2))
+        for label, curve in curves.items():
+            axes.plot(curve.forward_displacement, curve.forward_force,
+                      label=f"ours, {label}, forward")
+            axes.plot(curve.backward_displacement, curve.backward_force, ls="--",
+                      label=f"ours, {label}, backward")
+        force = experiments["contact_force_at_equilibrium_N"]
+        axes.plot([experiments["contact_test_total_displacement_mm"]], [force["measured"]],
+                  "ks", label="paper, measured at equilibrium")
+        axes.axhline(force["simulated"], color="grey", ls="-.", label="paper, simulated")
+        axes.set_xlabel("probe displacement since first load [mm]")
+        axes.set_ylabel("contact force [N]")
+        axes.set_title("C-60 contact-force test (prototype clearances)")
+        axes.legend(fontsize=7)
+        path = directory / "c60_contact_force.png"
+        figure.tight_layout()
+        figure.savefig(path, dpi=110)
+        plt.close(figure)
+        out["Contact force vs displacement"] = path
+    return out
+
+
+def _trip_failure(run: Run) -> str:
+    """The reference engine's trouble in the run, where it happened (step, contact, figures)."""
+    trajectory = run.trajectory
+    projections = list(trajectory.metadata.get("unconverged_projections", []))
+    depth = metrics.penetration(run.scene, trajectory)
+    worst = int(np.argmax(depth.max(axis=0))) if depth.size else 0
+    text = (f"c60-trip: {len(run.unconverged)} step(s) whose contact problem did not converge "
+            f"{run.unconverged[:5]}, {len(projections)} whose projection did not converge")
+    if projections:
+        first = projections[0]
+        name = run.scene.contacts[worst].name
+        onset = float(trajectory.times[np.argmax(depth[:, worst] > 1e-6)])
+        text += (f", from step {first} (t = {first * trajectory.time_step:.3f} ms) on: the "
+                 f"handle, spinning freely after the trip (no OFF stop in the source's "
+                 f"contacts), is moved by the projection out of its J1 bearing; largest "
+                 f"penetration {depth.max():.3f} mm ({name}, from t = {onset:.3f} ms)")
+    return text + "."
