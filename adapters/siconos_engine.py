@@ -11,21 +11,30 @@ TIMED_OUT), never an exception.
 Presets (each a separate engine variant ``siconos[preset]`` in results):
 
 - ``default``: ``MoreauJeanOSI`` with theta = 1/2, no projection; ``FrictionContact`` solved by
-  NSGS (``GenericMechanical`` NSGS when the scene has ideal joints); tolerance 1e-10 on
-  Siconos's normalised residual.
+  NSGS, or ``GenericMechanical`` (NSGS, local contact solver NSN_GP_HYBRID) when the scene
+  has ideal joints; tolerance 1e-10 on Siconos's
+  normalised residual; contacts activate when y + h/2 y' <= 1e-10 x the smallest feature.
 - ``projection``: the same with the combined projection scheme
-  (``MoreauJeanCombinedProjectionOSI`` + ``TimeSteppingCombinedProjection``; MLCP projection
-  on the active set, tolerance 1e-8 of the scene's smallest feature length).
+  (``MoreauJeanCombinedProjectionOSI`` + ``TimeSteppingCombinedProjection``; enumerative MLCP
+  projection on the active set, tolerance 1e-8 x the scene's smallest feature length).
 - ``nsn-ac``: as ``default`` with the semismooth Newton (Alart-Curnier) fc3d solver (scenes
   with ideal joints still use ``GenericMechanical``, whose only solver is NSGS).
 
 Options (``RunSettings.options``) override: ``theta``, ``projection``, ``solver`` ("nsgs" /
 ``"nsn-ac"``), ``tolerance``, ``max_iterations``, ``newton_iterations``, ``newton_tolerance``,
-``constraint_tolerance`` [L], ``projection_max_iterations``, ``projection_solver`` ("enum",
-``"pgs"``, ``"lemke"``), ``contact_frame`` ("shared", or "siconos-builtin": Siconos 4.4's own
-contact Jacobian, whose first tangent is not orthogonal to the normal when n_z dominates and
-n_x != n_y; kept to document that bug), ``timeout`` [s] of the worker process and ``fault``
-(fault injection for tests: "segfault", "hang", "exception").
+``activation_threshold`` [L], ``constraint_tolerance`` [L], ``projection_max_iterations``,
+``projection_solver`` ("enum" or "pgs"), ``gmp_reduction`` ("auto": "gs" for closed loops,
+else "assemble"; or "gs", "substitute", "assemble", "mlcp": GenericMechanical's handling of
+equality rows), ``contact_frame`` ("shared", or
+"siconos-builtin": Siconos 4.4's own contact Jacobian, whose first tangent is not orthogonal to
+the normal when n_z dominates and n_x != n_y; kept to document that bug), ``timeout`` [s] of
+the worker process and ``fault`` (fault injection for tests: "segfault", "hang", "exception").
+
+Approximations, stated per feature by :meth:`SiconosEngine.capabilities`: springs are explicit
+forces (no stiffness Jacobian); rotation drivers prescribe the body-axis angular velocity
+aligned with the driven world axis at t = 0; position drivers are imposed through their rate.
+Unsupported: box-box and capsule-capsule pairs (their candidate count changes with the
+configuration; see :mod:`siconos_worker_geometry`).
 """
 
 from __future__ import annotations
@@ -63,10 +72,8 @@ DEFAULTS: dict = {
     "projection_max_iterations": 50,
     "projection_solver": "enum",
     "contact_frame": "shared",
-    # GenericMechanical: equality rows assembled with the contacts (iparam ISREDUCED); the
-    # default Gauss-Seidel over all blocks needed 10^4 sweeps per step on the Flores slider
-    # (joint rows redundant with the guide contacts) and still stalled at 1e-7.
-    "gmp_reduction": "assemble",
+    # GenericMechanical's handling of equality rows (iparam ISREDUCED), see resolved_options.
+    "gmp_reduction": "auto",
     "timeout": 3600.0,
     "fault": "",
 }
@@ -74,9 +81,9 @@ OPTION_NAMES = ("theta", "projection", "solver") + tuple(DEFAULTS) + (
     "constraint_tolerance", "activation_threshold")
 SOLVERS = ("nsgs", "nsn-ac")
 CONTACT_FRAMES = ("shared", "siconos-builtin")
-PROJECTION_SOLVERS = ("enum", "pgs", "lemke")
+PROJECTION_SOLVERS = ("enum", "pgs")
 FAULTS = ("", "segfault", "hang", "exception")
-GMP_REDUCTIONS = ("gs", "substitute", "assemble", "mlcp")
+GMP_REDUCTIONS = ("auto", "gs", "substitute", "assemble", "mlcp")
 
 _JOINT_CLASSES = {"revolute": "PivotJointR", "spherical": "KneeJointR",
                   "prismatic": "PrismaticJointR", "fixed": "FixedJointR"}
@@ -197,6 +204,13 @@ class SiconosEngine(Engine):
         # sinks 14 um at the first steps); 1e-10 of the smallest feature, as the reference's
         # activation margin, removes that and is far below any gap the metrics resolve.
         options.setdefault("activation_threshold", 1e-10 * smallest)
+        if options["gmp_reduction"] == "auto":
+            # Assembling the equality rows with the contacts converged in one sweep on the
+            # Flores slider, where Gauss-Seidel over all blocks (Siconos's default) needed 10^4
+            # sweeps per step and stalled at 1e-7 (joint rows redundant with guide contacts);
+            # but an assembled system with redundant joint rows (a planar closed loop rebuilt
+            # in 3D) is singular: the slider-crank aborted on NaN. Gauss-Seidel there.
+            options["gmp_reduction"] = "gs" if "closed_loop" in scene.features else "assemble"
         for name, allowed in (("solver", SOLVERS), ("contact_frame", CONTACT_FRAMES),
                               ("projection_solver", PROJECTION_SOLVERS), ("fault", FAULTS),
                               ("gmp_reduction", GMP_REDUCTIONS)):

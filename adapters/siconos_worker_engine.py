@@ -66,7 +66,7 @@ SETTINGS_KEYS = (
     "newton_tolerance",     # Newton tolerance
     "constraint_tolerance",  # projection tolerance, unilateral and equality [L]
     "projection_max_iterations",
-    "projection_solver",    # MLCP solver of the projection: "enum", "pgs", "lemke"
+    "projection_solver",    # MLCP solver of the projection: "enum" or "pgs"
     "activation_threshold",  # MoreauJeanOSI: active when y + h/2 y' <= threshold [L]
     "contact_frame",        # "shared" (Python relation frame) or "siconos-builtin"
     "gmp_reduction",        # GenericMechanical equality handling: "gs", "substitute",
@@ -204,6 +204,8 @@ class Pair:
         self.b_first = not self.body_b.fixed
         self._key = None
         self._value = None
+        self._fixed_a = None
+        self._fixed_b = None
 
     @staticmethod
     def _placement(shape, q):
@@ -212,15 +214,20 @@ class Pair:
 
     def evaluate(self, q_a, q_b):
         """Candidates at the body states q_a, q_b (7,) each: (gap - offset (K,), point_a (K, 3),
-        point_b (K, 3), frame (K, 3, 3), rotation_a, rotation_b)."""
+        point_b (K, 3), frame (K, 3, 3)). Cached on the last configuration; the placement of a
+        fixed body's shape is computed once."""
         key = (q_a.tobytes(), q_b.tobytes())
         if key != self._key:
-            position_a, orientation_a, rotation_a = self._placement(self.shape_a, q_a)
-            position_b, orientation_b, rotation_b = self._placement(self.shape_b, q_b)
+            if self._fixed_a is None or not self.body_a.fixed:
+                self._fixed_a = self._placement(self.shape_a, q_a)
+            if self._fixed_b is None or not self.body_b.fixed:
+                self._fixed_b = self._placement(self.shape_b, q_b)
+            position_a, orientation_a, _ = self._fixed_a
+            position_b, orientation_b, _ = self._fixed_b
             gap, point_a, point_b, frame = geometry.pair_contacts(
                 self.shape_a[0], self.shape_a[1], position_a, orientation_a,
                 self.shape_b[0], self.shape_b[1], position_b, orientation_b)
-            self._value = (gap - self.offset, point_a, point_b, frame, rotation_a, rotation_b)
+            self._value = (gap - self.offset, point_a, point_b, frame)
             self._key = key
         return self._value
 
@@ -255,7 +262,7 @@ def define_siconos_classes(sk):
 
         def _geometry(self, first, second):
             q_a, q_b = self.pair.split(first, second)
-            gap, point_a, point_b, frame, _, _ = self.pair.evaluate(q_a, q_b)
+            gap, point_a, point_b, frame = self.pair.evaluate(q_a, q_b)
             k = self.index
             if self.pair.b_first:
                 return gap[k], point_b[k], point_a[k], frame[k] * self.sign[:, None], q_b, q_a
@@ -564,8 +571,8 @@ class SiconosModel:
         self.solver_options = options
         if settings["projection"]:
             self.osi = sk.MoreauJeanCombinedProjectionOSI(theta)
-            projection_solver = {"enum": sn.SICONOS_MLCP_ENUM, "pgs": sn.SICONOS_MLCP_PGS,
-                                 "lemke": sn.SICONOS_MLCP_LCP_LEMKE}[settings["projection_solver"]]
+            projection_solver = {"enum": sn.SICONOS_MLCP_ENUM,
+                                 "pgs": sn.SICONOS_MLCP_PGS}[settings["projection_solver"]]
             self.position_problem = sk.MLCPProjectOnConstraints(projection_solver, 1.0)
             self.simulation = sk.TimeSteppingCombinedProjection(
                 self.nsds, self.td, self.osi, self.osnspb, self.position_problem, 2)

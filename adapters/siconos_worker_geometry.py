@@ -551,8 +551,8 @@ def _placement_precedes(pa, pos_a, rot_a, pb, pos_b, rot_b):
 
 def _tuples(params, position, rotation):
     params = tuple(float(v) for v in params) + (0.0,) * (8 - len(params))
-    position = tuple(float(v) for v in position)
-    rotation = tuple(tuple(float(v) for v in row) for row in np.asarray(rotation))
+    position = tuple(np.asarray(position, dtype=float).tolist())
+    rotation = tuple(tuple(row) for row in np.asarray(rotation, dtype=float).tolist())
     return params, position, rotation
 
 
@@ -587,14 +587,10 @@ def pair_contacts(kind_a, params_a, position_a, rotation_a, kind_b, params_b, po
         staged = _canonical(kind_b, pb, pos_b, rot_b, kind_a, pa, pos_a, rot_a)
     else:
         staged = _canonical(kind_a, pa, pos_a, rot_a, kind_b, pb, pos_b, rot_b)
-    count = len(staged)
-    gap = np.empty(count)
-    point_a = np.empty((count, 3))
-    point_b = np.empty((count, 3))
-    frame = np.empty((count, 3, 3))
+    gaps, points_a, points_b, frames = [], [], [], []
     previous_normal = None
     tangent = (0.0, 0.0, 0.0)
-    for k, (normal, first, g) in enumerate(staged):
+    for normal, first, g in staged:
         normal = _scale(normal, 1.0 / _norm(normal))
         second = _axpy(g, normal, first)
         if swap:
@@ -603,10 +599,8 @@ def pair_contacts(kind_a, params_a, position_a, rotation_a, kind_b, params_b, po
         if normal != previous_normal:
             tangent = frame_tangent(normal[0], normal[1], normal[2])
             previous_normal = normal
-        gap[k] = g
-        point_a[k] = first
-        point_b[k] = second
-        frame[k, 0] = normal
-        frame[k, 1] = tangent
-        frame[k, 2] = _cross(normal, tangent)
-    return gap, point_a, point_b, frame
+        gaps.append(g)
+        points_a.append(first)
+        points_b.append(second)
+        frames.append((normal, tangent, _cross(normal, tangent)))
+    return np.array(gaps), np.array(points_a), np.array(points_b), np.array(frames)
