@@ -5,7 +5,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test venv lint siconos clean
+.PHONY: demo test venv lint siconos clean clean-numba-cache chromium regress ci
 
 venv: $(STAMP)
 
@@ -21,8 +21,27 @@ demo: $(STAMP)
 lint: $(STAMP)
 	$(PY) -m ruff check .
 
-test: $(STAMP) lint siconos
+test: $(STAMP) lint siconos chromium
 	$(PY) -m pytest -m "not slow"
+
+# The quick regression suite against the committed baselines (CI runs it after the tests).
+regress: $(STAMP)
+	$(VENV)/bin/clearbench regress
+
+ci: test regress
+
+# Debian's chromium, for the test that opens the report in a headless browser; never fails the
+# build (the test skips, saying why, where it cannot be installed).
+chromium:
+	@if command -v chromium >/dev/null 2>&1; then \
+		echo "chromium: installed"; \
+	elif [ "$$(id -u)" = "0" ] && command -v apt-get >/dev/null 2>&1; then \
+		echo "chromium: installing Debian's chromium with apt-get"; \
+		( apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null ) \
+			|| echo "chromium: WARNING: apt-get could not install chromium; the browser test will be skipped"; \
+	else \
+		echo "chromium: not installed (needs root and apt-get); the browser test will be skipped"; \
+	fi
 
 # Debian's python3-siconos (Siconos 4.4) for the side-by-side validation; never fails the build.
 siconos:
@@ -38,3 +57,8 @@ siconos:
 
 clean:
 	rm -rf $(VENV) build *.egg-info
+
+# numba's on-disk cache does not notice edits to a compiled function's callees (an inlined
+# kernel edited in another module): after editing numba kernels, drop the caches.
+clean-numba-cache:
+	find . -path ./$(VENV) -prune -o \( -name '*.nbi' -o -name '*.nbc' \) -print -delete

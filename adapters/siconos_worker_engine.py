@@ -359,6 +359,7 @@ class Loads:
                 if key in load:
                     self.per_body[load[key]].append(load)
         self._unwrap = {}
+        self.nonfinite = False  # set when a load evaluated to NaN / inf (a diverging run)
 
     def has_loads(self, name):
         return bool(self.per_body[name])
@@ -413,7 +414,13 @@ class Loads:
                 moment_world += np.cross(arm, f)
             elif kind == "torsional_spring":
                 moment_world += self._torsion(load, name)
-        return force, rotation.T @ moment_world
+        moment = rotation.T @ moment_world
+        if not (np.isfinite(force).all() and np.isfinite(moment).all()):
+            # Siconos aborts (assert) on a NaN force: hand it zeros and let the step loop stop
+            # the run as diverged.
+            self.nonfinite = True
+            return np.zeros(3), np.zeros(3)
+        return force, moment
 
     def _torsion(self, load, name):
         body_a = self.bodies[load["body_a"]]
@@ -464,6 +471,9 @@ class SiconosModel:
         self.body_list = [Body(i, data) for i, data in enumerate(scene.get("bodies", []))]
         self.bodies = {b.name: b for b in self.body_list}
         self.loads = Loads(scene, self.bodies)
+        # Escape guard: far beyond anything a scene can mean, far below overflow.
+        extent = max([1.0] + [float(np.max(np.abs(b.q0[:3]))) for b in self.body_list])
+        self.escape_distance = 1e9 * extent
         self.nsds = sk.NonSmoothDynamicalSystem(0.0, (self.steps + 2) * self.h)
         self.keep = []  # every Python-side Siconos object, referenced for the whole run
         drivers_by_body = {}
@@ -662,8 +672,10 @@ class SiconosModel:
                     converged = False
                     unconverged.append(k)
             taken = k
-            finite = all(body.ds is None or np.isfinite(np.array(body.ds.q())).all()
-                         for body in self.body_list)
+            finite = not self.loads.nonfinite and all(
+                body.ds is None or (np.isfinite(np.array(body.ds.q())).all() and float(
+                    np.max(np.abs(np.array(body.ds.q())[:3]))) < self.escape_distance)
+                for body in self.body_list)
             if next_record < samples and (k == record[next_record] or not finite):
                 self._store_state(out, next_record, simulation.nextTime())
                 self._store_contacts(out, next_record)
@@ -676,7 +688,9 @@ class SiconosModel:
             simulation.nextStep()
             stepping += elapsed + time.perf_counter() - tick
             if not finite:
-                status, message = "diverged", f"non-finite state at step {k}"
+                status, message = "diverged", (
+                    f"non-finite or escaped state at step {k} (a load was not finite, or a "
+                    f"body went beyond {self.escape_distance:g} from the origin)")
                 break
         for key in out:
             out[key] = out[key][:next_record]

@@ -51,9 +51,10 @@ def reference_step_costs(repeat: int = 3) -> list[StepCost]:
     engine = create()
     cases = (("clearance-pendulum", RunSettings(horizon=1.0)),
              ("box-grid", RunSettings(horizon=0.2)))
+    parameters = {"box-grid": {"count": 30}}  # 120 corner contacts once settled
     out = []
     for name, settings in cases:
-        scene = get_scene(name)
+        scene = get_scene(name, **parameters.get(name, {}))
         engine.run(scene, RunSettings(horizon=10 * scene.time_step))  # compile, warm caches
         best = None
         for _ in range(repeat):
@@ -287,3 +288,42 @@ def crosscheck_markdown(rows: list[CrossCheckRow]) -> str:
             f"{r.reference_us_per_step:.0f} / {r.siconos_us_per_step:.0f} | "
             f"{r.time_ratio:.2f} | {100 * r.python_share:.0f} % |")
     return "\n".join(lines)
+
+
+@dataclass(frozen=True)
+class PhysicsRow:
+    """One expectation figure of one run."""
+
+    scene: str
+    time_step: float
+    expectation: str
+    figure: str
+    value: float
+    converged: bool
+    stepping_seconds: float
+
+
+def engine_physics_table(engine_name: str = "reference", preset: str = "default",
+                         time_steps: tuple = (None,), tag: str | None = None) -> list[PhysicsRow]:
+    """Every expectation figure of every library scene (optionally with ``tag``) for one engine
+    and preset, at each of ``time_steps`` (None: the scene's own step) [scene units]."""
+    import importlib
+
+    from clearbench.adapters.availability import ENGINE_MODULES
+    from clearbench.scenarios.registry import scene_names
+
+    from .expectations import evaluate
+
+    module = importlib.import_module(f"clearbench.adapters.{ENGINE_MODULES[engine_name]}")
+    engine = module.create(preset)
+    rows = []
+    for name in scene_names(tag):
+        scene = get_scene(name)
+        for step in time_steps:
+            trajectory = engine.run(scene, RunSettings(time_step=step))
+            for result in evaluate(scene, trajectory):
+                for figure, value in result.figures.items():
+                    rows.append(PhysicsRow(name, trajectory.time_step, result.name, figure,
+                                           value, bool(trajectory.solver_converged.all()),
+                                           trajectory.stepping_seconds))
+    return rows

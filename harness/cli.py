@@ -15,7 +15,14 @@ import sys
 #: Modules that each add one or more sub-commands (``register(subparsers)``).
 COMMAND_MODULES: tuple[str, ...] = (
     "clearbench.harness.cmd_scenes",
+    "clearbench.harness.cmd_run",
+    "clearbench.harness.cmd_sweep",
+    "clearbench.harness.cmd_stability",
+    "clearbench.harness.cmd_compare",
+    "clearbench.harness.cmd_report",
+    "clearbench.harness.cmd_regress",
     "clearbench.harness.cmd_c60_extract",
+    "clearbench.harness.cmd_bench_mujoco",
     "clearbench.harness.cmd_fclib",
     "clearbench.harness.cmd_bench",
 )

@@ -56,7 +56,46 @@ def bench_siconos_crosscheck(args: argparse.Namespace) -> int:
     return 0
 
 
+def bench_reference_physics(args: argparse.Namespace) -> int:
+    from .benchmarks import engine_physics_table
+
+    steps = tuple(float(x) for x in args.dt) if args.dt else (None,)
+    rows = engine_physics_table("reference", "default", steps, args.tag)
+    print("Reference engine against each library scene's expectations (scene units)")
+    print(f"{'scene':<20} {'h':>8} {'expectation':<16} {'figure':<28} {'value':>12} "
+          f"{'converged':>9}")
+    for r in rows:
+        print(f"{r.scene:<20} {r.time_step:>8.0e} {r.expectation:<16} {r.figure:<28} "
+              f"{r.value:>12.3e} {str(r.converged):>9}")
+    return 0
+
+
+def bench_flores_reference(args: argparse.Namespace) -> int:
+    from clearbench.adapters.base import RunSettings
+    from clearbench.adapters.reference import create
+    from clearbench.scenarios.registry import get_scene
+
+    from .expectations import evaluate
+
+    scene = get_scene("flores-slider-crank")
+    trajectory = create().run(scene, RunSettings(time_step=1e-5, record_every=10))
+    out = Path(args.out or "reports/trajectories/flores-slider-crank_reference.npz")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    trajectory.save(out)
+    print(f"Flores-Leine-Glocker slider-crank, reference engine, h = 1e-5 s, 0.2 s: "
+          f"{trajectory.steps} steps in {trajectory.stepping_seconds:.1f} s, "
+          f"unconverged steps: {len(trajectory.metadata['unconverged_steps'])}")
+    for result in evaluate(scene, trajectory):
+        print(f"  {result.name}: " + ", ".join(f"{k} = {v:.3e}" for k, v in result.figures.items()))
+    print(f"trajectory (every 10th step): {out}")
+    return 0
+
+
 BENCHMARKS = {
+    "flores-reference": (bench_flores_reference,
+                         "keeps the reference trajectory of the Flores slider-crank (h = 1e-5 s)"),
+    "reference-physics": (bench_reference_physics,
+                          "the reference engine against every scene's expectations"),
     "reference": (bench_reference, "us per step and per contact-iteration of the reference"),
     "clearance-ladder": (bench_clearance_ladder,
                          "clearance pendulum -> ideal pendulum as the clearance shrinks"),
@@ -74,6 +113,8 @@ def register(subparsers) -> None:
     parser.add_argument("name", nargs="?", help="benchmark name (see --list)")
     parser.add_argument("--list", action="store_true", help="list the benchmarks")
     parser.add_argument("--out", help="where a benchmark writes its figure")
+    parser.add_argument("--dt", nargs="+", help="time steps (scene units), where it applies")
+    parser.add_argument("--tag", help="only scenes with this tag, where it applies")
     parser.set_defaults(handler=run)
 
 

@@ -51,9 +51,14 @@ def register(subparsers) -> None:
     validate.set_defaults(handler=run_validate)
 
     demo = subparsers.add_parser(
-        "demo", help="the README's main job",
-        description="The main job: validate every registered scene and list the engines.",
+        "demo", help="the README's main job: validate the scenes, run the comparison, report",
+        description="The main job: validate every registered scene, list the engines, then run "
+        "the default comparison of the available engines (`clearbench compare`) and write the "
+        "report. Takes the options of `compare`.",
     )
+    from .cmd_compare import add_compare_options
+
+    add_compare_options(demo)
     demo.set_defaults(handler=run_demo)
 
 
@@ -130,5 +135,11 @@ def run_demo(args: argparse.Namespace) -> int:
         assert scene_from_dict(scene_to_dict(scene)) == scene
         print(f"  ok  {name:<22} {len(scene.bodies)} bodies, {len(scene.all_contacts)} "
               f"contact pairs, horizon {scene.horizon} {scene.units.time}")
+    print("\nEngines:")
+    for availability in all_availability():
+        state = "available" if availability.available else "unavailable"
+        print(f"  {availability.engine:<10} {state:<12} {availability.detail}")
     print()
-    return run_list(argparse.Namespace(tag=None))
+    from .cmd_compare import run_compare
+
+    return run_compare(args)

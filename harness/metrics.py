@@ -275,3 +275,47 @@ def output_values(scene: Scene, trajectory: Trajectory) -> dict[str, np.ndarray]
 def rotation_matrices(trajectory: Trajectory) -> np.ndarray:
     """(T, nb, 3, 3) body-to-world rotations."""
     return quat_to_matrix_batch(quat_normalize_batch(trajectory.orientations))
+
+
+def body_size(body) -> float:
+    """Size of a body [L]: its largest shape extent, or its centre-of-mass offset."""
+    sizes = []
+    for shape in body.shapes:
+        if hasattr(shape, "half_extents"):
+            sizes.append(float(np.linalg.norm(shape.half_extents)))
+        elif hasattr(shape, "radius"):
+            sizes.append(float(shape.radius) + float(getattr(shape, "half_length", 0.0)))
+    return max(sizes + [float(np.linalg.norm(body.center_of_mass))])
+
+
+def energy_scale(scene: Scene, energy: Energy) -> float:
+    """Energy a run is judged against [M L^2/T^2]: the largest of the peak kinetic energy, the
+    range of potential energy, and the sum of m |g| size over the moving bodies."""
+    gravity = float(np.linalg.norm(scene.gravity))
+    weight = sum(b.mass * gravity * body_size(b) for b in scene.bodies
+                 if b.motion is not Motion.FIXED)
+    potential = energy.gravity + energy.springs
+    scale = max(float(np.max(energy.kinetic)), float(np.ptp(potential)), weight)
+    return scale if scale > 0 else 1.0
+
+
+def contact_free(scene: Scene, trajectory: Trajectory) -> np.ndarray:
+    """(T,) True where every contact pair is strictly open (gap > 0)."""
+    if not scene.all_contacts:
+        return np.ones(len(trajectory.times), dtype=bool)
+    return np.all(contact_gaps(scene, trajectory) > 0.0, axis=1)
+
+
+def energy_growth(scene: Scene, trajectory: Trajectory, values: Energy | None = None) -> float:
+    """Largest rise of the total energy above its running minimum [M L^2/T^2].
+
+    Measured on the samples where every contact is open when there are at least two of them:
+    a compliant engine stores energy in a closed contact that :func:`energy` does not count
+    (its contact potential), and gives it back, which would read as a gain; between contacts
+    the count is complete. Scenes that never leave contact are measured on every sample.
+    """
+    total = (values if values is not None else energy(scene, trajectory)).total
+    free = contact_free(scene, trajectory)
+    if np.count_nonzero(free) >= 2:
+        total = total[free]
+    return float(np.max(total - np.minimum.accumulate(total)))

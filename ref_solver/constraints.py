@@ -275,8 +275,11 @@ def delassus(row_body, row_coef, m, inverse_blocks, cluster, cluster_dofs, clust
     ``inverse_blocks`` (6 nb, 6 nb) is the inverse iteration matrix, block diagonal by
     clusters of bodies coupled by springs; ``cluster`` (nb,) the cluster of each body;
     ``cluster_dofs`` the dof indices of cluster c at cluster_dofs[cluster_start[c]:...].
+    Only pairs of rows that touch a common cluster are visited, so the cost is the sum over
+    clusters of (rows touching it)^2, not m^2.
     """
     n = inverse_blocks.shape[0]
+    n_clusters = cluster_start.shape[0] - 1
     y = np.zeros((n, m))
     for j in range(m):
         for side in range(2):
@@ -290,23 +293,42 @@ def delassus(row_body, row_coef, m, inverse_blocks, cluster, cluster_dofs, clust
                 for i in range(6):
                     total += inverse_blocks[d, 6 * b + i] * row_coef[j, side, i]
                 y[d, j] += total
+    # Rows touching each cluster (a row whose two bodies share a cluster is listed once).
+    counts = np.zeros(n_clusters + 1, dtype=np.int64)
+    for j in range(m):
+        c0 = cluster[row_body[j, 0]] if row_body[j, 0] >= 0 else -1
+        c1 = cluster[row_body[j, 1]] if row_body[j, 1] >= 0 else -1
+        if c0 >= 0:
+            counts[c0 + 1] += 1
+        if c1 >= 0 and c1 != c0:
+            counts[c1 + 1] += 1
+    for c in range(n_clusters):
+        counts[c + 1] += counts[c]
+    members = np.empty(counts[n_clusters], dtype=np.int64)
+    fill = counts[:n_clusters].copy()
+    for j in range(m):
+        c0 = cluster[row_body[j, 0]] if row_body[j, 0] >= 0 else -1
+        c1 = cluster[row_body[j, 1]] if row_body[j, 1] >= 0 else -1
+        if c0 >= 0:
+            members[fill[c0]] = j
+            fill[c0] += 1
+        if c1 >= 0 and c1 != c0:
+            members[fill[c1]] = j
+            fill[c1] += 1
     w = np.zeros((m, m))
-    for i in range(m):
-        ci0 = cluster[row_body[i, 0]] if row_body[i, 0] >= 0 else -1
-        ci1 = cluster[row_body[i, 1]] if row_body[i, 1] >= 0 else -1
-        for j in range(m):
-            cj0 = cluster[row_body[j, 0]] if row_body[j, 0] >= 0 else -2
-            cj1 = cluster[row_body[j, 1]] if row_body[j, 1] >= 0 else -2
-            if not (ci0 == cj0 or ci0 == cj1 or ci1 == cj0 or ci1 == cj1):
-                continue
-            total = 0.0
-            for side in range(2):
-                b = row_body[i, side]
-                if b < 0:
-                    continue
-                for k in range(6):
-                    total += row_coef[i, side, k] * y[6 * b + k, j]
-            w[i, j] = total
+    for c in range(n_clusters):
+        for a in range(counts[c], counts[c + 1]):
+            i = members[a]
+            for bb in range(counts[c], counts[c + 1]):
+                j = members[bb]
+                total = 0.0
+                for side in range(2):
+                    b = row_body[i, side]
+                    if b < 0 or cluster[b] != c:
+                        continue
+                    for k in range(6):
+                        total += row_coef[i, side, k] * y[6 * b + k, j]
+                w[i, j] += total
     return w, y
 
 

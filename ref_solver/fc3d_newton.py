@@ -165,8 +165,12 @@ def solve_newton(
     iteration = 0
     residual = np.inf
 
+    # Products W r: dense numpy below the dense limit (a scipy.sparse product costs ~10 us of
+    # Python overhead per call, more than the arithmetic of a small problem).
+    W_product = W_dense if W_dense is not None else W
+
     def measure(r_: np.ndarray) -> tuple[np.ndarray, float]:
-        u_ = W @ r_ + q
+        u_ = W_product @ r_ + q
         _, rel_q, rel_max = residual_both(r_, u_, q, mu, nb)
         return u_, (rel_max if use_max else rel_q)
 
@@ -196,7 +200,7 @@ def solve_newton(
             step_ok = False
             for _ in range(_MAX_HALVINGS):
                 r_try = r + step * d
-                u_try = W @ r_try + q
+                u_try = W_product @ r_try + q
                 merit_try = alart_curnier_system(r_try, u_try, mu, nb, rho_n, rho_t, rho_b,
                                                  phi_try, A_try, B_try, False)
                 if merit_try <= (1.0 - 2.0 * _ARMIJO * step) * merit:
@@ -226,7 +230,7 @@ def solve_newton(
     if status is SolverStatus.MAX_ITERATIONS:
         message = (f"{options.max_iterations} Newton iterations done, residual {residual:.3g}"
                    f" > {options.tolerance:.3g}")
-    u = W @ r + q
+    u = W_product @ r + q
     _, residual_q, residual_max = residual_both(r, u, q, mu, nb)
     if status is not SolverStatus.NUMERICAL_FAILURE:
         residual = residual_max if use_max else residual_q

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from clearbench.scenarios.quaternion import quat_exp, quat_rotate
+from clearbench.scenarios.quaternion import quat_exp, quat_integrate, quat_rotate
 
 from .linalg3 import mat_vec
 
@@ -50,3 +50,13 @@ def gyroscopic_update(omega, inertia, inverse_inertia, fixed, h, theta, toleranc
             worst = max_iterations
         out[b] = current
     return out, worst
+
+
+@njit(cache=True)
+def integrate_orientations(p, rotation_vectors, fixed):
+    """p_b * exp(rotation_vectors_b) for every body that is not fixed, (nb, 4)."""
+    out = p.copy()
+    for b in range(p.shape[0]):
+        if not fixed[b]:
+            out[b] = quat_integrate(p[b], rotation_vectors[b])
+    return out

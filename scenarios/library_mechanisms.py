@@ -27,14 +27,15 @@ def _rotation_about_y(angle: float) -> tuple:
     return (math.cos(0.5 * angle), 0.0, math.sin(0.5 * angle), 0.0)
 
 
-ROD_RADIUS = 0.02  # m, radius of the pendulum rod (sets its small axial moment)
+ROD_RADIUS_RATIO = 0.02  # radius of the pendulum rod per unit length (its small axial moment)
 
 
 def pendulum_rod_inertia(mass: float, length: float) -> tuple:
     """Inertia about the centre of mass of a uniform rod of length 2 ``length`` hung from one
     end (centre of mass ``length`` below the pivot), axis along body z [kg m^2]."""
     transverse = mass * (2.0 * length) ** 2 / 12.0
-    return diagonal(transverse, transverse, 0.5 * mass * ROD_RADIUS**2)
+    radius = ROD_RADIUS_RATIO * length
+    return diagonal(transverse, transverse, 0.5 * mass * radius**2)
 
 
 def _pendulum_bob(initial_angle: float, length: float, mass: float) -> Body:

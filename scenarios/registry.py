@@ -49,7 +49,7 @@ def register(name: str, tags: Iterable[str], summary: str, **fixed_parameters):
 def _load_library() -> None:
     # Importing the library modules fills SCENES (kept here so that importing the registry is
     # enough for every caller).
-    from . import library_basic, library_mechanisms  # noqa: F401
+    from . import library_basic, library_mechanisms, library_stiff  # noqa: F401
 
 
 def scene_names(tag: str | None = None) -> list[str]:

@@ -15,8 +15,10 @@ from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.shapes import Arc, Box, Capsule, Circle, Cylinder, Plane, Sphere
 from clearbench.scenarios.units import UnitSystem
 
+# Values below 1e-200 are excluded: rescaling to um-mg-us multiplies some by 1e-6, and values
+# pushed into the subnormal range lose digits (no scene has such values).
 finite = st.floats(min_value=-1e3, max_value=1e3, allow_nan=False, allow_infinity=False,
-                   allow_subnormal=False)
+                   allow_subnormal=False).filter(lambda x: x == 0.0 or abs(x) > 1e-200)
 positive = st.floats(min_value=1e-3, max_value=1e3, allow_nan=False, allow_infinity=False)
 vector3 = st.tuples(finite, finite, finite)
 

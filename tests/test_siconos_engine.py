@@ -281,14 +281,23 @@ def test_every_library_scene_runs_or_is_unsupported_with_a_reason(name, tmp_path
     if engine.unsupported_reasons(scene):
         assert trajectory.status is RunStatus.UNSUPPORTED and trajectory.message
         return
-    assert trajectory.status is RunStatus.OK, trajectory.message
-    assert trajectory.steps == steps and len(trajectory.times) == steps + 1
+    if trajectory.status is RunStatus.DIVERGED:
+        # A divergence is a recorded outcome, allowed only where the engine declared an
+        # approximation that explains it (stiff-spring: explicit spring force at omega h = 10).
+        assert trajectory.message
+        assert any(c.support is Support.APPROXIMATED
+                   for c in engine.capabilities(scene).values()), trajectory.message
+    else:
+        assert trajectory.status is RunStatus.OK, trajectory.message
+        assert trajectory.steps == steps and len(trajectory.times) == steps + 1
+    samples = len(trajectory.times)
     nb, npair = len(scene.bodies), len(scene.all_contacts)
-    assert trajectory.positions.shape == (steps + 1, nb, 3)
-    assert trajectory.contact_force.shape == (steps + 1, npair, 3)
+    assert trajectory.positions.shape == (samples, nb, 3)
+    assert trajectory.contact_force.shape == (samples, npair, 3)
+    finite = slice(None) if trajectory.status is RunStatus.OK else slice(0, -1)
     for array in (trajectory.positions, trajectory.orientations, trajectory.velocities,
                   trajectory.angular_velocities, trajectory.contact_force):
-        assert np.isfinite(array).all()
+        assert np.isfinite(array[finite]).all()
     # Unit quaternions: Siconos integrates q additively and normalises; measured up to 3e-12
     # after 20 steps (the Flores crank at 150 rad/s); 1e-9 would flag a missing normalisation
     # (an O(h omega)^2 error per step) long before it matters.

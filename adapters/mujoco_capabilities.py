@@ -1,0 +1,192 @@
+"""What the MuJoCo adapter does with each scene feature: native, approximated (how, how
+large) or unsupported (why). Pure Python: stated without compiling a model."""
+
+from __future__ import annotations
+
+from clearbench.scenarios.bodies import Motion
+from clearbench.scenarios.scene import Scene
+from clearbench.scenarios.shapes import Arc, Circle, Plane
+
+from .base import Capability, Support
+from .mujoco_geometry import ring_piece_radius
+from .mujoco_settings import (
+    MujocoSettings,
+    damping_ratio_for_restitution,
+    restitution_for_damping_ratio,
+    ring_chord_error,
+    ring_clearance_error,
+)
+from .mujoco_topology import plan_topology
+
+NATIVE_SHAPES = {"sphere": "sphere", "box": "box", "capsule": "capsule"}
+
+
+def _approx(detail: str) -> Capability:
+    return Capability(Support.APPROXIMATED, detail)
+
+
+def _native(detail: str) -> Capability:
+    return Capability(Support.NATIVE, detail)
+
+
+def describe_solref(solref: tuple, timeconst_steps: float | None) -> str:
+    """``(0.02, 1)`` or ``(2 dt, 1)`` when the timeconst follows the time step."""
+    if timeconst_steps is None:
+        return f"({solref[0]:g}, {solref[1]:g})"
+    return f"({timeconst_steps:g} dt, {solref[1]:g})"
+
+
+def describe_plastic(settings: MujocoSettings) -> str:
+    """What e = 0 pairs become."""
+    if settings.map_plastic:
+        zeta = settings.plastic_damping_ratio
+        return f"e = 0 get zeta = {zeta:g} (e = {restitution_for_damping_ratio(zeta):.3f})"
+    zeta = settings.solref[1]
+    return (f"e = 0 keep dampratio {zeta:g}, i.e. they rebound with "
+            f"e = {restitution_for_damping_ratio(zeta):.3f}")
+
+
+def ring_summary(scene: Scene, settings: MujocoSettings) -> list[str]:
+    """One line per circle/arc shape: pieces, piece radius and chord error [scene L]."""
+    out = []
+    unit = scene.units.length
+    for body in scene.expanded.bodies:
+        for shape in body.shapes:
+            if isinstance(shape, Circle | Arc):
+                rho = ring_piece_radius(scene, body.name, shape, settings)
+                chord = ring_chord_error(shape.radius, settings.ring_pieces, settings.ring_piece)
+                out.append(f"{body.name}/{shape.name}: R {shape.radius:.6g} {unit}, "
+                           f"{settings.ring_piece}s of radius {rho:.3g} {unit}, chord error "
+                           f"{chord:.3g} {unit}")
+    return out
+
+
+def clearance_summary(scene: Scene, settings: MujocoSettings) -> list[str]:
+    """Per clearance joint: chord error of its bore next to the clearance it distorts."""
+    out = []
+    unit = scene.units.length
+    for joint in scene.clearance_joints:
+        chord = ring_chord_error(joint.bore_radius, settings.ring_pieces, settings.ring_piece)
+        extra = ring_clearance_error(joint.bore_radius, joint.radial_clearance,
+                                     settings.ring_pieces, settings.ring_piece)
+        out.append(
+            f"{joint.name}: bore R {joint.bore_radius:.6g} {unit} as {settings.ring_pieces} "
+            f"{settings.ring_piece}s, chord error {chord:.3g} {unit} "
+            f"({100 * chord / joint.radial_clearance:.3g} % of the radial clearance "
+            f"{joint.radial_clearance:.3g} {unit}); the journal sees the clearance grow by "
+            f"at most {extra:.3g} {unit} between two pieces")
+    return out
+
+
+def mujoco_capabilities(scene: Scene, settings: MujocoSettings) -> dict[str, Capability]:
+    """Capability of every feature in ``scene.features``."""
+    topology = plan_topology(scene)
+    problems: dict[str, list[str]] = {}
+    for feature, reason in topology.problems:
+        problems.setdefault(feature, []).append(reason)
+    closures = set(topology.closures)
+    joint_kind = {j.name: j.kind for j in scene.joints}
+    moving_planes = [f"{b.name}/{s.name}" for b in scene.expanded.bodies for s in b.shapes
+                     if isinstance(s, Plane) and b.motion is not Motion.FIXED]
+    out: dict[str, Capability] = {}
+    for feature in sorted(scene.features):
+        if feature in problems:
+            out[feature] = Capability(Support.UNSUPPORTED, "; ".join(problems[feature]))
+            continue
+        out[feature] = _feature(feature, scene, settings, topology, closures, joint_kind,
+                                moving_planes)
+    return out
+
+
+def _feature(feature, scene, settings, topology, closures, joint_kind, moving_planes):
+    if feature in ("gravity", "fixed_bodies"):
+        return _native("gravity option" if feature == "gravity" else "static bodies")
+    if feature == "contacts":
+        return _approx(
+            "one <pair> per scene pair and geom piece (contype = conaffinity = 0, so nothing "
+            "else collides); MuJoCo contacts are soft constraints that let the gap go below "
+            f"zero (solref {describe_solref(settings.solref, settings.timeconst_steps)}, "
+            f"solimp {settings.solimp[:3]}); a pair's offset is its MuJoCo pair margin")
+    if feature == "friction":
+        if settings.cone == "pyramidal":
+            return _approx("pyramidal cone, soft: a body below the friction angle creeps "
+                           "(ENGINES.md: 636 um in 1 s on a 10 degree incline, mu 0.3); "
+                           "noslip has no effect with this cone")
+        if settings.noslip_iterations > 0:
+            return _approx(f"elliptic cone with {settings.noslip_iterations} noslip "
+                           "iterations (ENGINES.md: creep 0.06 um in 1 s at 10 iterations)")
+        return _approx("elliptic cone, soft: creeps (ENGINES.md: 444 um in 1 s)")
+    if feature == "restitution":
+        zeta_08 = damping_ratio_for_restitution(0.8, settings.plastic_damping_ratio)
+        return _approx(
+            "MuJoCo has no restitution parameter: e becomes the dampratio of a unilateral "
+            f"spring-damper (zeta(0.8) = {zeta_08:.4f}), constant impedance, timeconst long "
+            f"enough for {settings.restitution_contact_steps:g} steps per contact (softer "
+            "contacts, deeper penetration); pairs with " + describe_plastic(settings))
+    if feature.startswith("shape:"):
+        kind = feature[6:]
+        if kind in NATIVE_SHAPES:
+            return _native(f"MuJoCo {NATIVE_SHAPES[kind]}")
+        if kind == "cylinder":
+            return _native("MuJoCo cylinder (its flat end caps collide too; the scene's "
+                           "cylinder touches on its lateral surface only)")
+        if kind == "plane":
+            if moving_planes:
+                return _approx(
+                    "MuJoCo plane on fixed bodies; on moving bodies (MuJoCo planes must be "
+                    f"static) a cube of half size {settings.plane_box_size:g} x the scene "
+                    f"size whose face is the plane: {', '.join(moving_planes)}")
+            return _native("MuJoCo plane")
+        if kind in ("circle", "arc"):
+            return _approx(f"ring of {settings.ring_pieces} {settings.ring_piece}s per full "
+                           "circle: " + "; ".join(ring_summary(scene, settings)))
+    if feature in ("rings", "arcs"):
+        return _approx(f"{settings.ring_pieces} {settings.ring_piece}s per full circle "
+                       "(see shape:circle / shape:arc)")
+    if feature.startswith("pair:"):
+        return _native("MuJoCo collision function for the two geom types (one pair per "
+                       "piece of a ring)")
+    if feature == "ideal_joints":
+        if closures:
+            return _approx("tree joints (exact) on a spanning tree; loops closed by soft "
+                           f"equalities: {', '.join(sorted(closures))}")
+        return _native("tree joints (hinge / slide / ball / welded child): exact")
+    if feature.startswith("joint:"):
+        kind = feature[6:]
+        soft = sorted(name for name in closures if joint_kind[name] == kind)
+        if soft:
+            how = {"revolute": "two connect equalities on the axis",
+                   "spherical": "one connect equality", "fixed": "one weld equality"}[kind]
+            return _approx(f"tree {kind} joints exact; loop-closing ones ({', '.join(soft)}) "
+                           f"as {how} (soft, drift)")
+        return _native({"revolute": "hinge", "prismatic": "slide", "spherical": "ball",
+                        "fixed": "child welded to its parent"}[kind] + " in the tree: exact")
+    if feature == "closed_loop":
+        solref = describe_solref(settings.equality_solref, settings.equality_timeconst_steps)
+        return _approx(f"loop-closing joints are soft equalities (solref {solref}): they drift")
+    if feature == "clearance_joints":
+        return _approx("journal cylinder against bearing rings and flange planes against "
+                       "thrust rings, rings as convex pieces: " +
+                       "; ".join(clearance_summary(scene, settings)))
+    if feature == "springs":
+        return _native("spatial tendon between two sites (stiffness, damping, springlength); "
+                       "preload as a constant motor force on the tendon")
+    if feature == "torsional_springs":
+        return _approx("joint stiffness/damping where a tree hinge joins the two bodies about "
+                       "the spring axis (exact); otherwise an explicit moment from the "
+                       "relative rotation, applied before every step")
+    if feature in ("point_forces", "moments"):
+        return _native("xfrc_applied at the centre of mass (with the moment of the offset), "
+                       "set before every step")
+    if feature == "time_switched_loads":
+        return _approx("switched at the first step that starts inside the window "
+                       "(resolution one time step)")
+    if feature == "drivers":
+        return _approx(
+            "each driven component is a joint of the body (hinge / slide to a fixed body, or "
+            "world slides) with armature "
+            f"{settings.driver_armature_ratio:g} x its inertia, position and velocity reset to "
+            "the profile before every step (exact at step starts; reactions from the "
+            "dynamics). Not mocap bodies: MuJoCo gives them no velocity, so contacts and "
+            "joined bodies would not see the motion")
+    return Capability(Support.UNSUPPORTED, "feature not handled by the MuJoCo adapter")

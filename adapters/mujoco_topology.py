@@ -1,0 +1,199 @@
+"""How a scene's bodies, ideal joints and drivers map onto MuJoCo's kinematic tree.
+
+MuJoCo integrates a tree of bodies in joint coordinates: joints of the tree are exact, anything
+else is a soft equality constraint. The scene's joint graph is therefore split into a spanning
+tree (Kruskal, preferring prismatic, then revolute, spherical and fixed joints as tree edges,
+so that the joints left over to close loops are the ones MuJoCo's equalities can express) and
+loop closures:
+
+==========  =======================  ================================================
+joint       tree edge                loop closure
+==========  =======================  ================================================
+revolute    hinge                    two ``connect`` equalities on the axis
+spherical   ball                     one ``connect`` equality
+prismatic   slide                    unsupported (no MuJoCo equality keeps one slide)
+fixed       no joint (welded child)  ``weld`` equality
+==========  =======================  ================================================
+
+Bodies joined to no fixed body get a free joint. A driven body needs each prescribed component
+to be one degree of freedom of its own joints, which is the case for (a) a hinge (slide) to a
+fixed body about (along) the world axis of its one driven component, or (b) a body with no
+tree joint driven in translation only: it gets slides along world x, y, z and a ball joint at
+its centre of mass. Pure Python: no ``mujoco`` import.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+from clearbench.scenarios.bodies import Motion
+from clearbench.scenarios.drivers import Driver
+from clearbench.scenarios.scene import Scene
+
+#: Preference of a joint kind as a tree edge (lower first).
+TREE_PRIORITY = {"prismatic": 0, "revolute": 1, "spherical": 2, "fixed": 3}
+#: MuJoCo tree joint realising each scene joint kind (None: child welded to its parent).
+TREE_JOINT = {"revolute": "hinge", "prismatic": "slide", "spherical": "ball", "fixed": None}
+AXIS_TOLERANCE = 1e-9  # |1 - |a . b|| below which a joint axis is a world axis
+
+
+@dataclass(frozen=True)
+class DrivenDof:
+    """A driven degree of freedom: ``joint`` of the MuJoCo body moves as ``sign`` times the
+    driver's displacement / velocity."""
+
+    driver: Driver
+    joint: str          # 'tree' (the body's tree hinge/slide) or 'slide_x' / 'slide_y' / ...
+    sign: float = 1.0
+
+
+@dataclass(frozen=True)
+class TreeLink:
+    """How one scene body enters the MuJoCo tree.
+
+    kind: 'static' (fixed body, child of the world, no joint), 'free' (free joint),
+    'translation_driven' (slides x, y, z + ball at the centre of mass), 'hinge', 'slide',
+    'ball' or 'weld' (tree joint ``joint`` to ``parent``).
+    """
+
+    body: str
+    parent: str | None
+    kind: str
+    joint: str | None = None
+
+
+@dataclass(frozen=True)
+class Topology:
+    """Tree links in parent-before-child order, loop closures, driven dofs and the reasons
+    (feature, why) for which the scene cannot be built."""
+
+    links: tuple
+    closures: tuple
+    driven: dict
+    problems: tuple
+    ignored_joints: tuple = ()
+
+    def link(self, body: str) -> TreeLink:
+        for link in self.links:
+            if link.body == body:
+                return link
+        raise KeyError(body)
+
+    @property
+    def tree_joints(self) -> tuple:
+        return tuple(link.joint for link in self.links if link.joint is not None)
+
+
+def plan_topology(scene: Scene) -> Topology:
+    """Split the joint graph of ``scene`` into a MuJoCo tree and loop closures."""
+    fixed = {b.name for b in scene.bodies if b.motion is Motion.FIXED}
+    parent: dict[str, str] = {}
+
+    def node(name: str) -> str:
+        return "<fixed>" if name in fixed else name
+
+    def root(name: str) -> str:
+        while parent.get(name, name) != name:
+            name = parent[name]
+        return name
+
+    ignored = []
+    tree_edges, closures = [], []
+    order = sorted(range(len(scene.joints)),
+                   key=lambda i: (TREE_PRIORITY[scene.joints[i].kind], i))
+    for i in order:
+        joint = scene.joints[i]
+        if joint.body_a in fixed and joint.body_b in fixed:
+            ignored.append(joint.name)
+            continue
+        a, b = root(node(joint.body_a)), root(node(joint.body_b))
+        if a == b:
+            closures.append(joint)
+        else:
+            parent[a] = b
+            tree_edges.append(joint)
+    adjacency: dict[str, list] = {b.name: [] for b in scene.bodies}
+    for joint in tree_edges:
+        adjacency[joint.body_a].append((joint, joint.body_b))
+        adjacency[joint.body_b].append((joint, joint.body_a))
+
+    links: list[TreeLink] = []
+    visited: set[str] = set()
+    queue: deque[str] = deque()
+    drivers_of: dict[str, list] = {}
+    for driver in scene.drivers:
+        drivers_of.setdefault(driver.body, []).append(driver)
+
+    def visit_from(start: str) -> None:
+        queue.append(start)
+        while queue:
+            current = queue.popleft()
+            for joint, other in adjacency[current]:
+                if other in visited:
+                    continue
+                visited.add(other)
+                kind = TREE_JOINT[joint.kind] or "weld"
+                links.append(TreeLink(other, current, kind, joint.name))
+                queue.append(other)
+
+    for body in scene.bodies:
+        if body.name in fixed:
+            visited.add(body.name)
+            links.append(TreeLink(body.name, None, "static"))
+    for body in scene.bodies:
+        if body.name in fixed:
+            visit_from(body.name)
+    for body in scene.bodies:
+        if body.name not in visited:
+            visited.add(body.name)
+            driven_root = body.motion is Motion.DRIVEN and not any(
+                d.is_rotation for d in drivers_of.get(body.name, ()))
+            links.append(TreeLink(body.name, None,
+                                  "translation_driven" if driven_root else "free"))
+            visit_from(body.name)
+
+    problems = []
+    for joint in closures:
+        if joint.kind == "prismatic":
+            reason = (f"prismatic joint {joint.name!r} closes a loop: no MuJoCo equality "
+                      "constraint leaves exactly one sliding freedom")
+            problems += [("closed_loop", reason), ("joint:prismatic", reason)]
+    driven, driver_problems = _plan_drivers(scene, links, fixed, drivers_of)
+    problems += driver_problems
+    return Topology(tuple(links), tuple(j.name for j in closures), driven, tuple(problems),
+                    tuple(ignored))
+
+
+def _plan_drivers(scene: Scene, links: list, fixed: set, drivers_of: dict):
+    joints = {j.name: j for j in scene.joints}
+    by_body = {link.body: link for link in links}
+    driven: dict[str, tuple] = {}
+    problems = []
+    for body, drivers in drivers_of.items():
+        link = by_body[body]
+        components = ", ".join(d.component for d in drivers)
+        if link.kind == "translation_driven":
+            driven[body] = tuple(DrivenDof(d, f"slide_{d.component}") for d in drivers)
+            continue
+        if link.kind in ("hinge", "slide") and link.parent in fixed and len(drivers) == 1:
+            driver = drivers[0]
+            joint = joints[link.joint]
+            axis = np.asarray(joint.axis, dtype=float)
+            world = np.eye(3)[driver.axis_index]
+            alignment = float(axis @ world)
+            wanted = "hinge" if driver.is_rotation else "slide"
+            if link.kind == wanted and abs(abs(alignment) - 1.0) < AXIS_TOLERANCE:
+                # A joint is stated in body_a -> body_b terms; the tree child moves relative to
+                # the fixed parent, so the sign follows the axis alignment only.
+                driven[body] = (DrivenDof(driver, "tree", float(np.sign(alignment))),)
+                continue
+        problems.append((
+            "drivers",
+            f"body {body!r} (drivers on {components}): MuJoCo can prescribe a component only as "
+            "its own joint: one rotation (translation) by a hinge (slide) to a fixed body "
+            "about (along) that world axis, or translations of a body with no ideal joint",
+        ))
+    return driven, problems

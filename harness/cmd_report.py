@@ -1,0 +1,30 @@
+"""``clearbench report``: the HTML page and Markdown summary from a results store."""
+
+from __future__ import annotations
+
+import argparse
+
+from .cli_common import add_store_option, open_store
+from .report import write_report
+
+
+def register(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "report", help="write the HTML report and Markdown summary from a results store",
+        description="Read a results store and write a self-contained HTML page (figures "
+        "embedded) and a Markdown summary: overview matrix scene x engine, the stiff suite, "
+        "per scene a metrics table, work–precision plot and drift over time, and the "
+        "approximations each engine states.",
+    )
+    add_store_option(parser)
+    parser.add_argument("--out", default="reports/out", metavar="DIR",
+                        help="output directory (default reports/out)")
+    parser.set_defaults(handler=run_report)
+
+
+def run_report(args: argparse.Namespace) -> int:
+    store = open_store(args, create=False)
+    paths = write_report(store, args.out)
+    print(f"report: {paths['html']}")
+    print(f"summary: {paths['markdown']}")
+    return 0

@@ -1,0 +1,143 @@
+"""A tiny engine following the adapter contract, for the harness tests.
+
+It integrates free flight only (gravity, constant angular velocity; contacts and joints ignored)
+with the symplectic Euler method, so its error against the exact ballistic motion is O(dt).
+Presets misbehave on purpose:
+
+- ``default``: free flight as above;
+- ``segfault``: the process kills itself with SIGSEGV;
+- ``hang``: never returns;
+- ``nan``: positions become NaN halfway, status still OK (the harness must catch it);
+- ``raise``: raises RuntimeError;
+- ``energy``: velocities grow 1 % per step, status OK (energy growth must be caught).
+
+Options: ``sleep`` (seconds to sleep before running), ``bias`` (every recorded z drifts up at
+this rate [L/T], velocities untouched: a position error that grows with time). The
+environment variable ``CLEARBENCH_FAKE_BIAS`` adds to ``bias`` (to inject a regression without
+touching a suite definition), and ``CLEARBENCH_FAKE_NAN`` (non-empty) makes every preset behave
+as ``nan``. Clearance joints are reported unsupported.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import signal
+import time
+
+import numpy as np
+
+from clearbench.adapters.base import Capability, Engine, RunSettings, Support
+from clearbench.adapters.trajectory import RunStatus, Trajectory
+from clearbench.scenarios.bodies import Motion
+
+PRESETS = {"default": {}, "segfault": {}, "hang": {}, "nan": {}, "raise": {}, "energy": {}}
+OPTION_NAMES = ("sleep", "bias")
+
+
+def availability() -> tuple[bool, str]:
+    return True, "fake engine for tests 1.0"
+
+
+def create(preset: str = "default") -> FakeEngine:
+    if preset not in PRESETS:
+        raise ValueError(f"unknown fake preset {preset!r}")
+    return FakeEngine(preset)
+
+
+def _quat_multiply(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    w1, v1 = p[0], p[1:]
+    w2, v2 = q[0], q[1:]
+    return np.concatenate(([w1 * w2 - v1 @ v2], w1 * v2 + w2 * v1 + np.cross(v1, v2)))
+
+
+def _quat_exp(rotation: np.ndarray) -> np.ndarray:
+    angle = float(np.linalg.norm(rotation))
+    if angle == 0.0:
+        return np.array([1.0, 0.0, 0.0, 0.0])
+    return np.concatenate(([math.cos(angle / 2)], math.sin(angle / 2) * rotation / angle))
+
+
+class FakeEngine(Engine):
+    name = "fake"
+
+    def __init__(self, preset: str = "default"):
+        self.preset = preset
+
+    def capabilities(self, scene):
+        out = {}
+        for feature in scene.features:
+            if feature == "clearance_joints":
+                out[feature] = Capability(Support.UNSUPPORTED, "fake engine has no clearances")
+            elif feature in ("contacts", "ideal_joints"):
+                out[feature] = Capability(Support.APPROXIMATED, "ignored (free flight only)")
+            else:
+                out[feature] = Capability(Support.NATIVE, "")
+        return out
+
+    def _run(self, scene, settings: RunSettings) -> Trajectory:
+        options = settings.options
+        time.sleep(float(options.get("sleep", 0.0)))
+        if self.preset == "segfault":
+            os.kill(os.getpid(), signal.SIGSEGV)
+        if self.preset == "hang":
+            while True:
+                time.sleep(0.05)
+        if self.preset == "raise":
+            raise RuntimeError("fake engine failure")
+        bias = float(options.get("bias", 0.0)) + float(os.environ.get("CLEARBENCH_FAKE_BIAS", 0))
+        built = time.perf_counter()
+        h = settings.time_step or scene.time_step
+        horizon = settings.horizon or scene.horizon
+        steps = int(math.ceil(horizon / h - 1e-9))
+        record = list(range(0, steps + 1, settings.record_every))
+        if record[-1] != steps:
+            record.append(steps)
+        nb = len(scene.bodies)
+        free = np.array([b.motion is not Motion.FIXED for b in scene.bodies])
+        x = np.array([b.position for b in scene.bodies], dtype=float)
+        q = np.array([b.orientation for b in scene.bodies], dtype=float)
+        v = np.array([b.velocity for b in scene.bodies], dtype=float) * free[:, None]
+        w = np.array([b.angular_velocity for b in scene.bodies], dtype=float) * free[:, None]
+        g = np.asarray(scene.gravity, dtype=float)
+        count = len(record)
+        nc = len(scene.all_contacts)
+        out = {
+            "positions": np.zeros((count, nb, 3)), "orientations": np.zeros((count, nb, 4)),
+            "velocities": np.zeros((count, nb, 3)), "angular_velocities": np.zeros((count, nb, 3)),
+        }
+        start = time.perf_counter()
+        slot = 0
+        for k in range(steps + 1):
+            if k > 0:
+                v = v + h * g * free[:, None]
+                if self.preset == "energy":
+                    v = v * 1.01
+                x = x + h * v
+                for b in np.nonzero(free)[0]:
+                    q[b] = _quat_multiply(q[b], _quat_exp(h * w[b]))
+            if slot < count and k == record[slot]:
+                out["positions"][slot] = x
+                out["positions"][slot, :, 2] += bias * k * h
+                out["orientations"][slot] = q
+                out["velocities"][slot] = v
+                out["angular_velocities"][slot] = w
+                slot += 1
+        stepping = time.perf_counter() - start
+        if self.preset == "nan" or os.environ.get("CLEARBENCH_FAKE_NAN"):
+            out["positions"][count // 2:] = np.nan
+        return Trajectory(
+            engine=self.name, preset=self.preset, scene_name=scene.name,
+            scene_hash=scene.content_hash,
+            units={"length": scene.units.length, "mass": scene.units.mass,
+                   "time": scene.units.time},
+            time_step=h, body_names=tuple(b.name for b in scene.bodies),
+            contact_names=tuple(c.name for c in scene.all_contacts),
+            times=np.array(record, dtype=float) * h,
+            contact_normal_force=np.zeros((count, nc)), contact_force=np.zeros((count, nc, 3)),
+            solver_iterations=np.zeros(count, dtype=np.int64), solver_residual=np.zeros(count),
+            solver_converged=np.ones(count, dtype=bool),
+            active_contacts=np.zeros(count, dtype=np.int64),
+            build_seconds=start - built, stepping_seconds=stepping, steps=steps,
+            status=RunStatus.OK, **out,
+        )

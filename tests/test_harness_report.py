@@ -1,0 +1,134 @@
+"""The report renders from a small store, is self-contained, and opens in headless Chromium."""
+
+from __future__ import annotations
+
+import base64
+import re
+import shutil
+import subprocess
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from clearbench.harness.cli import main
+from clearbench.harness.report import write_report
+from clearbench.harness.report_figures import work_precision_figure
+from clearbench.harness.run_spec import make_run_spec
+from clearbench.harness.runner import Runner
+from clearbench.harness.store import ResultsStore
+from clearbench.harness.sweep import pareto_front, work_precision_points
+
+from .harness_helpers import FAKE, needs_metrics
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.fixture(scope="module")
+def small_store(tmp_path_factory):
+    """A store with ok, diverged, crashed and unsupported runs over a few scenes."""
+    directory = tmp_path_factory.mktemp("store")
+    store = ResultsStore(directory)
+    specs = [make_run_spec("bouncing-ball-e0.5", "fake", time_step=dt, horizon=0.3,
+                           extra_engine_modules=FAKE, campaign="sweep") for dt in (1e-3, 5e-4)]
+    specs += [
+        make_run_spec("torque-free-flip", "fake[nan]", horizon=0.3, extra_engine_modules=FAKE),
+        make_run_spec("pendulum", "fake[segfault]", horizon=0.3, extra_engine_modules=FAKE),
+        make_run_spec("clearance-pendulum", "fake", horizon=0.3, extra_engine_modules=FAKE),
+        make_run_spec("stiff-spring", "fake", horizon=0.3, extra_engine_modules=FAKE),
+    ]
+    Runner(store, jobs=2).run_all(specs)
+    return store
+
+
+def test_report_writes_html_and_markdown(small_store, tmp_path):
+    paths = write_report(small_store, tmp_path / "out")
+    page = paths["html"].read_text()
+    summary = paths["markdown"].read_text()
+    for scene in ("bouncing-ball-e0.5", "torque-free-flip", "pendulum", "clearance-pendulum",
+                  "stiff-spring"):
+        assert scene in page and scene in summary
+    for status in ("ok", "diverged", "crashed", "unsupported"):
+        assert status in page
+    assert "Stiff and extreme suite" in page and "Overview" in page
+    assert "SIGSEGV" in page  # the crash's message is shown
+    assert "clearance_joints" in page  # the fake engine's stated limitation
+    # Self-contained: no external resource of any kind.
+    assert not re.search(r"""(src|href)=['"](https?:|//|file:)""", page)
+    for encoded in re.findall(r"data:image/png;base64,([A-Za-z0-9+/=]+)", page):
+        assert base64.b64decode(encoded).startswith(PNG_SIGNATURE)
+
+
+def test_report_command(small_store, tmp_path, capsys):
+    out = tmp_path / "report"
+    assert main(["report", "--store", str(small_store.directory), "--out", str(out)]) == 0
+    assert (out / "report.html").exists() and (out / "summary.md").exists()
+    assert main(["report", "--store", str(tmp_path / "empty"), "--out", str(out)]) == 2
+    assert "no results store" in capsys.readouterr().err
+
+
+def _chromium() -> str | None:
+    return shutil.which("chromium") or shutil.which("chromium-browser")
+
+
+def test_report_opens_in_headless_chromium(small_store, tmp_path):
+    browser = _chromium()
+    if browser is None:
+        pytest.skip("Debian's chromium is not installed (the Makefile's test target installs "
+                    "it when run as root)")
+    paths = write_report(small_store, tmp_path / "out")
+    screenshot = tmp_path / "report.png"
+    flags = [browser, "--headless", "--no-sandbox", "--disable-gpu", "--enable-logging=stderr",
+             "--v=0", f"--user-data-dir={tmp_path / 'profile'}"]
+    shot = subprocess.run(flags + [f"--screenshot={screenshot}", "--window-size=1200,1600",
+                                   paths["html"].as_uri()],
+                          capture_output=True, text=True, timeout=120)
+    assert shot.returncode == 0, shot.stderr[-2000:]
+    # Page errors (script errors, failed resources) are logged as CONSOLE lines.
+    page_errors = [line for line in shot.stderr.splitlines()
+                   if "CONSOLE" in line or "Uncaught" in line or "Failed to load" in line]
+    assert not page_errors, page_errors
+    data = screenshot.read_bytes()
+    assert data.startswith(PNG_SIGNATURE)
+    import matplotlib.image
+
+    pixels = matplotlib.image.imread(str(screenshot))
+    # A rendered page has text and coloured cells: far more than one distinct colour.
+    assert len(np.unique(pixels.reshape(-1, pixels.shape[-1]), axis=0)) > 20
+    dom = subprocess.run(flags + ["--dump-dom", paths["html"].as_uri()], capture_output=True,
+                         text=True, timeout=120)
+    assert dom.returncode == 0
+    assert "<table>" in dom.stdout and "bouncing-ball-e0.5" in dom.stdout
+
+
+def test_pareto_front_keeps_the_non_dominated_points():
+    times = np.array([1.0, 2.0, 3.0, 2.5, np.nan, 4.0])
+    errors = np.array([1e-1, 1e-2, 1e-3, 5e-2, 1e-9, 1e-3])
+    # (2.5, 5e-2) is beaten by (2.0, 1e-2); (4.0, 1e-3) by (3.0, 1e-3); NaN never on it.
+    assert pareto_front(times, errors).tolist() == [True, True, True, False, False, False]
+
+
+def test_work_precision_points_and_figure():
+    frame = pd.DataFrame({
+        "scene_name": ["s"] * 4, "campaign": ["sweep", "sweep", "sweep", "sweep:fine-reference"],
+        "label": ["a[default]", "a[default]", "b[default]", "reference[default]"],
+        "time_step": [1e-3, 5e-4, 1e-3, 1e-5], "error": [1e-2, 5e-3, 1e-3, np.nan],
+        "stepping_seconds_per_simulated_second": [0.1, 0.2, 0.5, 20.0],
+        "status": ["ok"] * 4, "key": ["k1", "k2", "k3", "k4"],
+    })
+    points = work_precision_points(frame, "s")
+    assert list(points["key"]) == ["k2", "k1", "k3"]  # by engine, then step; no fine reference
+    assert points["pareto"].tolist() == [True, True, True]
+    png = work_precision_figure(points, "s")
+    assert png.startswith(PNG_SIGNATURE)
+
+
+@needs_metrics
+def test_time_series_figure_from_a_fake_run(small_store):
+    from clearbench.harness.report_figures import time_series_figure
+
+    frame = small_store.dataframe()
+    row = frame[(frame["scene_name"] == "bouncing-ball-e0.5")].iloc[0]
+    scene = small_store.scene(row["scene_hash"])
+    png = time_series_figure(scene, {"fake": small_store.load_trajectory(row["key"])})
+    assert png is not None and png.startswith(PNG_SIGNATURE)
