@@ -247,7 +247,9 @@ def _crosscheck_row(scene, preset, ours, theirs) -> CrossCheckRow:
     divergence = _first_time(times, com_distance, com_range)
     for key in ours_out:
         difference = np.abs(theirs_out[key] - ours_out[key])
-        scale = float(np.ptp(ours_out[key])) or 1.0
+        # An output that does not move (the Flores slider's angle, ~1e-11 rad) is compared
+        # with a floor of 1e-6 in its unit, not with its round-off range.
+        scale = max(float(np.ptp(ours_out[key])), 1e-6)
         if float(np.max(difference)) / scale > worst:
             worst = float(np.max(difference)) / scale
             output_name, output_difference = key, float(np.max(difference))
