@@ -160,12 +160,14 @@ def test_clearance_pendulum_agrees_with_the_reference_solver():
     assert ours.status is RunStatus.OK and theirs.status is RunStatus.OK
     angle_ours = metrics.output_values(scene, ours)["angle"]
     angle_theirs = metrics.output_values(scene, theirs)["angle"]
-    # Both are Moreau-Jean theta = 1/2 schemes with the combined projection, with the same
-    # gaps and frames; they differ in the impact/activation rule (Siconos: predicted gap,
-    # ours: restitution threshold and activation margin) and the one-step solver. Over 0.5 s
-    # the bob swings 1 rad; the tolerance is 10 radial clearances over the rod length
-    # (1e-3 rad): the motion the clearance allows, not the angle scale. Measured: see README.
-    assert np.max(np.abs(angle_theirs - angle_ours)) <= 10 * 1e-4 / 1.0
+    # Both are Moreau-Jean theta = 1/2 schemes with the combined projection and the same
+    # gaps and frames. They differ in how a constraint that stays closed dissipates: Siconos
+    # imposes the end-of-step velocity and loses energy at first order in h (the IDEAL
+    # pendulum already differs from ours by 3.9e-4 rad after 0.5 s, see
+    # test_ideal_joints_lose_energy_at_first_order_in_h); the clearance adds an O(c / L) =
+    # 1e-4 rad freedom. Bound: twice their sum, 1e-3 rad (measured 4.6e-4 rad; 9.5e-3 rad
+    # after the full 3 s, see README).
+    assert np.max(np.abs(angle_theirs - angle_ours)) <= 1e-3
     # The projection keeps the bore on the journal to within its tolerance (1e-8 of the
     # smallest feature, 1e-12 m): excess below 1e-11 m.
     assert metrics.clearance_motion(scene, theirs).excess.max() <= 1e-11
