@@ -273,9 +273,8 @@ def _sticks(scene, trajectory, exp):
 
 def _energy_non_increasing(scene, trajectory, exp):
     energy = metrics.energy(scene, trajectory)
-    growth = metrics.energy_growth(scene, trajectory, energy)
-    return ({"energy_growth": growth,
-             "energy_growth_relative": growth / metrics.energy_scale(scene, energy)},
+    growth, scale = metrics.energy_growth(scene, trajectory, energy)
+    return ({"energy_growth": growth, "energy_growth_relative": growth / scale},
             "energy_growth_relative",
             "largest rise above the running minimum, on contact-free samples when there are any")
 

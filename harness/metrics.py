@@ -306,16 +306,19 @@ def contact_free(scene: Scene, trajectory: Trajectory) -> np.ndarray:
     return np.all(contact_gaps(scene, trajectory) > 0.0, axis=1)
 
 
-def energy_growth(scene: Scene, trajectory: Trajectory, values: Energy | None = None) -> float:
-    """Largest rise of the total energy above its running minimum [M L^2/T^2].
+def energy_growth(scene: Scene, trajectory: Trajectory,
+                  values: Energy | None = None) -> tuple[float, float]:
+    """Largest rise of the total energy above its running minimum, and the energy scale it is
+    judged against, both [M L^2/T^2] and both over the same samples.
 
     Measured on the samples where every contact is open when there are at least two of them:
     a compliant engine stores energy in a closed contact that :func:`energy` does not count
     (its contact potential), and gives it back, which would read as a gain; between contacts
     the count is complete. Scenes that never leave contact are measured on every sample.
     """
-    total = (values if values is not None else energy(scene, trajectory)).total
+    values = values if values is not None else energy(scene, trajectory)
     free = contact_free(scene, trajectory)
     if np.count_nonzero(free) >= 2:
-        total = total[free]
-    return float(np.max(total - np.minimum.accumulate(total)))
+        values = Energy(values.kinetic[free], values.gravity[free], values.springs[free])
+    total = values.total
+    return float(np.max(total - np.minimum.accumulate(total))), energy_scale(scene, values)
