@@ -45,7 +45,7 @@ chromium:
 
 # Debian's python3-siconos (Siconos 4.4) for the side-by-side validation; never fails the build.
 siconos:
-	@if env -i PATH=/usr/bin:/bin /usr/bin/python3 -c "import siconos.numerics" >/dev/null 2>&1; then \
+	@if env -i PATH=/usr/bin:/bin /usr/bin/python3 -c "import siconos.numerics, siconos.kernel, siconos.mechanics.joints" >/dev/null 2>&1; then \
 		echo "siconos: python3-siconos is installed"; \
 	elif [ "$$(id -u)" = "0" ] && command -v apt-get >/dev/null 2>&1; then \
 		echo "siconos: installing python3-siconos with apt-get"; \

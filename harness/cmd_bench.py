@@ -42,6 +42,20 @@ def bench_clearance_ladder(args: argparse.Namespace) -> int:
     return 0
 
 
+def bench_siconos_crosscheck(args: argparse.Namespace) -> int:
+    from clearbench.adapters.siconos_engine import availability
+
+    from .benchmarks import crosscheck_markdown, siconos_crosscheck
+
+    available, detail = availability()
+    if not available:
+        raise UserError(f"the Siconos cross-check needs Siconos: {detail}")
+    print(f"Reference solver against Siconos ({detail}), each scene at its own time step and "
+          "horizon; differences are maxima over the run")
+    print(crosscheck_markdown(siconos_crosscheck()))
+    return 0
+
+
 def bench_reference_physics(args: argparse.Namespace) -> int:
     from .benchmarks import engine_physics_table
 
@@ -103,6 +117,9 @@ BENCHMARKS = {
     "clearance-ladder": (bench_clearance_ladder,
                          "clearance pendulum -> ideal pendulum as the clearance shrinks"),
     "c60": (bench_c60, "wall time and solver statistics of full c60-trip and c60-on runs"),
+    "siconos-crosscheck": (bench_siconos_crosscheck,
+                           "reference solver vs Siconos 4.4 on the analytic scenes, the clearance "
+                           "pendulum and the Flores slider-crank"),
 }
 
 
