@@ -28,7 +28,17 @@ def _rotation(q) -> np.ndarray:
     return quat_to_matrix(np.asarray(q, dtype=float) / np.linalg.norm(q))
 
 
-@pytest.mark.parametrize("name", NAMES)
+# Scenes MuJoCo can build: every library scene except the C-60 ones, whose law loads, bores and
+# bounded faces the adapter does not map yet (they get an explicit unsupported verdict).
+SUPPORTED = [n for n in NAMES if not create("default").unsupported_reasons(get_scene(n))]
+
+
+def test_only_the_c60_scenes_are_unsupported():
+    unsupported = set(NAMES) - set(SUPPORTED)
+    assert all("c60" in get_scene(n).tags for n in unsupported), sorted(unsupported)
+
+
+@pytest.mark.parametrize("name", SUPPORTED)
 def test_compiled_mass_inertia_and_pose_equal_the_scene(name):
     scene = get_scene(name)
     built = build_model(scene, resolve_settings("default"), scene.time_step)
@@ -57,7 +67,7 @@ def test_compiled_mass_inertia_and_pose_equal_the_scene(name):
         assert np.all(model.dof_armature[others] == 0.0)
 
 
-@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("name", SUPPORTED)
 def test_first_sample_reproduces_initial_twists(name):
     scene = get_scene(name)
     trajectory = create("default").run(scene, RunSettings(horizon=scene.time_step))
@@ -130,7 +140,8 @@ def test_every_feature_has_a_stated_capability(name):
         assert set(capabilities) == set(scene.features)
         for feature, capability in capabilities.items():
             assert capability.detail, f"{feature} has no explanation"
-            assert capability.support is not Support.UNSUPPORTED, capability.detail
+            if name in SUPPORTED:
+                assert capability.support is not Support.UNSUPPORTED, capability.detail
 
 
 def test_clearance_joint_rings_report_their_chord_error_next_to_the_clearance():
