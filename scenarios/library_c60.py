@@ -8,7 +8,8 @@
   with the prototype's clearances (Table 7), see :mod:`.c60_bench`.
 
 Every factory takes ``clearances`` (joint -> radial clearance [mm]), ``time_step`` and
-``horizon`` [ms] where it applies, and ``handle_spring_arm`` (see :mod:`.c60_model`);
+``horizon`` [ms] where it applies, and ``handle_spring_arm`` (see :mod:`.c60_model`; the
+contact-force test takes the design arm by default, see :mod:`.c60_bench`);
 ``c60-on`` also ``contact_spring_preload`` [rad] (the source's 0.49 by default).
 """
 
@@ -66,7 +67,7 @@ def c60_trip(clearances: Mapping[str, float] | None = None, horizon: float = 20.
           summary="C-60 bench test: probe in place of the fixed contact, force vs displacement")
 def c60_contact_force_test(clearances: Mapping[str, float] | None = None,
                            probe_speed: float = 0.1, time_step: float = 1e-3,
-                           handle_spring_arm: str = "source") -> Scene:
+                           handle_spring_arm: str = "design") -> Scene:
     return c60_bench.contact_force_test_scene(
         clearances=clearances, probe_speed=probe_speed, time_step=time_step,
         handle_spring_arm=handle_spring_arm)
