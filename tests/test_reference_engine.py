@@ -136,27 +136,10 @@ def test_clearance_pendulum_stays_within_its_clearance():
 CLEARANCE_LADDER = ((1e-3, 1e-3), (1e-4, 3e-4), (1e-5, 1e-4))
 
 
-def clearance_ladder_errors(horizon: float, ladder=CLEARANCE_LADDER) -> list[float]:
-    """Largest angle difference [rad] between the frictionless clearance pendulum and the
-    exact ideal pendulum, for each (clearance, step) of the ladder."""
-    from clearbench.scenarios import analytic
-
-    ideal = get_scene("pendulum").expectations[0].parameters
-    frequency = analytic.physical_pendulum_frequency(
-        ideal["mass"], ideal["pivot_distance"], ideal["pivot_inertia"], ideal["gravity"])
-    errors = []
-    for clearance, step in ladder:
-        scene = get_scene("clearance-pendulum", radial_clearance=clearance,
-                          axial_clearance=clearance, friction=0.0)
-        trajectory = ENGINE.run(scene, RunSettings(time_step=step, horizon=horizon))
-        angle = ideal["initial_angle"] + metrics.output_values(scene, trajectory)["angle"]
-        exact = analytic.pendulum_angle(trajectory.times, ideal["initial_angle"], frequency)
-        errors.append(float(np.max(np.abs(angle - exact))))
-    return errors
-
-
 def test_clearance_pendulum_approaches_the_ideal_pendulum():
-    errors = clearance_ladder_errors(horizon=0.3)
+    from clearbench.harness.benchmarks import clearance_ladder
+
+    errors = [rung.angle_error for rung in clearance_ladder(0.3, CLEARANCE_LADDER)]
     # The difference from the ideal pendulum goes to zero with the clearance: each rung
     # (10x smaller clearance) at least halves it (measured ratios about 7 and 5).
     assert errors[1] < errors[0] / 2
