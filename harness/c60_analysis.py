@@ -110,10 +110,28 @@ class TripForceCurve:
     trip_distance: float
 
 
-def trip_force_curve(scene: Scene, trajectory: Trajectory, release_fraction: float = 0.05
+def running_median(values: np.ndarray, width: int) -> np.ndarray:
+    """Median of each window of ``width`` (odd) samples centred on each sample (edges padded
+    with the end values)."""
+    half = width // 2
+    padded = np.concatenate((np.full(half, values[0]), values, np.full(half, values[-1])))
+    windows = np.lib.stride_tricks.sliding_window_view(padded, width)
+    return np.median(windows, axis=1)
+
+
+def trip_force_curve(scene: Scene, trajectory: Trajectory, median_width: int = 5,
+                     released_for: float = 0.02, release_transient: float = 0.005
                      ) -> TripForceCurve:
-    """The trip distance is the displacement at which the force, after its peak, falls below
-    ``release_fraction`` of the peak (the latch let go; NaN if it never does)."""
+    """Probe force against displacement since first contact.
+
+    The release is where the force drops to zero for at least ``released_for`` mm of probe
+    travel (the latch let go; NaN if it never does); the trip distance is the displacement
+    there. The peak is the largest force over the loading phase, taken on the force smoothed
+    by a running median of ``median_width`` recorded samples and up to ``release_transient``
+    mm before the release: the first touch and the release are impacts (the bar kicked
+    against the probe as the latch lets go: up to 16 N in single 0.02 ms samples) that a
+    quasi-static load cell does not register. The curve itself is returned raw.
+    """
     values = metrics.output_values(scene, trajectory)
     force = values["probe_force"]
     position = values["probe_y"]
@@ -124,10 +142,20 @@ def trip_force_curve(scene: Scene, trajectory: Trajectory, release_fraction: flo
     first = touching[0]
     displacement = position[first:] - position[first]
     force = force[first:]
-    peak = int(np.argmax(force))
-    after = np.nonzero(force[peak:] < release_fraction * force[peak])[0]
-    trip = float(displacement[peak + after[0]]) if after.size else math.nan
-    return TripForceCurve(displacement, force, float(force[peak]), float(displacement[peak]),
+    loaded = force > FORCE_THRESHOLD
+    release = None
+    for index in np.nonzero(loaded[:-1] & ~loaded[1:])[0] + 1:
+        later = np.nonzero(loaded[index:])[0]
+        reloaded_at = displacement[index + later[0]] if later.size else math.inf
+        if reloaded_at - displacement[index] >= released_for:
+            release = index
+            break
+    trip = float(displacement[release]) if release is not None else math.nan
+    limit = trip - release_transient if release is not None else math.inf
+    smooth = running_median(force, median_width)
+    window = np.nonzero(displacement <= limit)[0]
+    peak = int(window[np.argmax(smooth[window])])
+    return TripForceCurve(displacement, force, float(smooth[peak]), float(displacement[peak]),
                           trip)
 
 

@@ -67,6 +67,7 @@ def contact_force_test_scene(
     hold: float = 2.0,
     time_step: float = 1e-3,
     handle_spring_arm: str = "design",
+    contact_spring_preload: float = model.CONTACT_SPRING_PRELOAD,
 ) -> Scene:
     """Section 5.2: probe in place of the fixed contact, forward to the reference and back.
 
@@ -104,7 +105,8 @@ def contact_force_test_scene(
                           offset=float(c7["offset"]))
     return model.c60_scene(
         name, clearances=clearances, horizon=times[-1] + 0.2, time_step=time_step,
-        handle_spring_arm=handle_spring_arm, without_contacts=(model.C7,),
+        handle_spring_arm=handle_spring_arm, contact_spring_preload=contact_spring_preload,
+        without_contacts=(model.C7,),
         extra_bodies=(probe,), extra_contacts=(contact,),
         extra_drivers=_probe_drivers("x", times, values, "position"),
         extra_outputs=(ContactForce("probe_force", contact="Probe_C7"),
@@ -138,6 +140,7 @@ def trip_force_test_scene(
     stroke: float = 0.9,
     time_step: float = 1e-3,
     handle_spring_arm: str = "source",
+    contact_spring_preload: float = model.CONTACT_SPRING_PRELOAD,
 ) -> Scene:
     """Section 5.3, pin side: a spherical probe pushes the tripping bar's pin along world +y.
 
@@ -173,7 +176,8 @@ def trip_force_test_scene(
     horizon = slow_from + stroke / probe_speed
     return model.c60_scene(
         name, clearances=clearances, horizon=horizon, time_step=time_step,
-        handle_spring_arm=handle_spring_arm, extra_shapes={"tripping_bar": (pin,)},
+        handle_spring_arm=handle_spring_arm, contact_spring_preload=contact_spring_preload,
+        extra_shapes={"tripping_bar": (pin,)},
         extra_bodies=(probe,), extra_contacts=(contact,),
         extra_drivers=_probe_drivers(
             "y", (0.0, SETTLE_TIME, SETTLE_TIME, slow_from, slow_from),

@@ -22,9 +22,9 @@ as the source does), each CAD surface reduced to a shape:
 * concave cylinder patch (the C4 hollow) and the plunger's sleeve -> :class:`~.shapes.Bore`
   (angles and length bounded);
 * plane face -> :class:`~.shapes.Rectangle` (its bounding rectangle in the face's (u, v) axes),
-  or :class:`~.shapes.Disc` for the round plunger face; the normal is turned toward the partner
-  surface in the ON pose (the material side is behind it), which agrees with the part's
-  ``outward`` flag wherever the extraction determined it;
+  or :class:`~.shapes.Disc` for the round plunger face; the normal points out of the material
+  as the part's ``outward`` flag says, or toward the partner surface in the ON pose for the
+  frame's faces (no material data); a single face must face its partner (checked);
 * arc (a half ring standing for a rounded edge) -> :class:`~.shapes.Arc`; stray points dropped.
 
 A surface made of several faces (the C4 wedge of the tripping bar: side plane, top plane,
@@ -54,7 +54,10 @@ plugin functions being registered as internal forces that Siconos subtracts):
 * ``contact_pressure_spring``: angle law M = 244.46 (theta_mc - theta_plate + (54.54 + 22) deg +
   0.49 rad) N mm, applied as a force M / 5.48 along plate body (-1.1, 0.9, 0) at its centre of
   mass, a moment 0.2513 M about world z on the plate, and a force M / 6.06 along moving-contact
-  body (0.6, -1.1, -0.01) at its centre of mass.
+  body (0.6, -1.1, -0.01) at its centre of mass. The source's comment lists 0.6547 and 0.9599
+  rad as other preloads (``contact_spring_preload``); with 0.9599 FC-1 is 13.1 N and FC-6
+  0.658 mm, where the paper's Monte Carlo means are 13.66 N and 0.659 mm (0.49: 7.35 N,
+  0.511 mm).
 * ``tripping_bar_moment``: a moment on the tripping bar about world z for t < 1 ms. The source's
   function returns +15 N mm, registered as an internal moment, i.e. the physical moment is
   -15 N mm (it presses the bar toward its stop, away from tripping).

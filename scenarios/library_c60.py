@@ -10,7 +10,7 @@
 Every factory takes ``clearances`` (joint -> radial clearance [mm]), ``time_step`` and
 ``horizon`` [ms] where it applies, and ``handle_spring_arm`` (see :mod:`.c60_model`; the
 contact-force test takes the design arm by default, see :mod:`.c60_bench`);
-``c60-on`` also ``contact_spring_preload`` [rad] (the source's 0.49 by default).
+and ``contact_spring_preload`` [rad] (the source's 0.49 by default).
 """
 
 from __future__ import annotations
@@ -67,17 +67,21 @@ def c60_trip(clearances: Mapping[str, float] | None = None, horizon: float = 20.
           summary="C-60 bench test: probe in place of the fixed contact, force vs displacement")
 def c60_contact_force_test(clearances: Mapping[str, float] | None = None,
                            probe_speed: float = 0.1, time_step: float = 1e-3,
-                           handle_spring_arm: str = "design") -> Scene:
+                           handle_spring_arm: str = "design",
+                           contact_spring_preload: float = c60_model.CONTACT_SPRING_PRELOAD
+                           ) -> Scene:
     return c60_bench.contact_force_test_scene(
         clearances=clearances, probe_speed=probe_speed, time_step=time_step,
-        handle_spring_arm=handle_spring_arm)
+        handle_spring_arm=handle_spring_arm, contact_spring_preload=contact_spring_preload)
 
 
 @register("c60-trip-force-test", tags=("c60", "bench"),
           summary="C-60 bench test: probe pushes the tripping-bar pin until the latch releases")
 def c60_trip_force_test(clearances: Mapping[str, float] | None = None,
                         probe_speed: float = 0.02, time_step: float = 1e-3,
-                        handle_spring_arm: str = "source") -> Scene:
+                        handle_spring_arm: str = "source",
+                        contact_spring_preload: float = c60_model.CONTACT_SPRING_PRELOAD
+                        ) -> Scene:
     return c60_bench.trip_force_test_scene(
         clearances=clearances, probe_speed=probe_speed, time_step=time_step,
-        handle_spring_arm=handle_spring_arm)
+        handle_spring_arm=handle_spring_arm, contact_spring_preload=contact_spring_preload)
