@@ -179,6 +179,7 @@ class MoreauJeanStepper:
         k = MAX_CONTACTS_PER_PAIR
         self.previous_impulse = np.zeros((npair, k, 3))
         self.previous_bilateral = np.zeros(system.bilateral_row_count)
+        self._newton_first = False  # hybrid: the last problem needed Newton (see _solve)
         self.single_clusters = (np.arange(nb, dtype=np.int64),
                                 np.arange(6 * nb, dtype=np.int64),
                                 np.arange(0, 6 * nb + 1, 6, dtype=np.int64))
@@ -320,27 +321,42 @@ class MoreauJeanStepper:
         ``hybrid``: NSGS for at most ``hybrid_sweeps`` sweeps from the warm start; when it has
         not converged, semismooth Newton from where NSGS stopped, then from the warm start, then
         from zero, then NSGS to its full cap from zero and from where it stopped, keeping the
-        first that converges (else the smallest residual). Redundant
+        first that converges (else the smallest residual); after a step that needed Newton,
+        Newton from the warm start is tried first. Redundant
         contacts (the two rings of a bearing) make W singular: NSGS crawls there and Newton can
         stall from a poor start, while another start converges in a few iterations.
         """
         cfg = self.settings
         if cfg.method != "hybrid":
             return solve_contact_problem(problem, replace(cfg.solver, method=cfg.method), r0=r0)
-        best = solve_contact_problem(
-            problem, replace(cfg.solver, method="nsgs", max_iterations=cfg.hybrid_sweeps), r0=r0)
-        if best.converged:
-            return best
-        iterations = best.iterations
         newton = replace(cfg.solver, method="newton", max_iterations=200)
+        iterations = 0
+        if self._newton_first:
+            # The last problem needed Newton: consecutive steps' problems are alike (the same
+            # redundant contacts), so Newton from the warm start first saves the NSGS sweeps
+            # that would stall again. Not converged: the usual chain follows.
+            best = solve_contact_problem(problem, newton, r0=r0)
+            if best.converged:
+                return best
+            iterations = best.iterations
+        nsgs_first = solve_contact_problem(
+            problem, replace(cfg.solver, method="nsgs", max_iterations=cfg.hybrid_sweeps), r0=r0)
+        iterations += nsgs_first.iterations
+        if nsgs_first.converged:
+            self._newton_first = False
+            return replace(nsgs_first, iterations=iterations)
+        if not self._newton_first or nsgs_first.residual < best.residual:
+            best = nsgs_first
         nsgs = replace(cfg.solver, method="nsgs")
-        attempts = ((newton, best.r), (newton, r0), (newton, None), (nsgs, None), (nsgs, best.r))
+        attempts = ((newton, nsgs_first.r), (newton, r0), (newton, None), (nsgs, None),
+                    (nsgs, nsgs_first.r))
         for options, start in attempts:
             attempt = solve_contact_problem(problem, options, r0=start)
             iterations += attempt.iterations
             if attempt.converged or attempt.residual < best.residual:
                 best = attempt
             if attempt.converged:
+                self._newton_first = options is newton
                 break
         return replace(best, iterations=iterations)
 
