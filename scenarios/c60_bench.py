@@ -63,7 +63,7 @@ def contact_force_test_scene(
     *,
     clearances: Mapping[str, float] | None = None,
     probe_speed: float = 0.1,
-    stroke: float = 2.4,
+    stroke: float = 2.8,
     hold: float = 2.0,
     time_step: float = 1e-3,
     handle_spring_arm: str = "design",
@@ -84,8 +84,9 @@ def contact_force_test_scene(
     probe_speed : float
         Probe speed [mm/ms] (the study: 5e-4).
     stroke : float
-        Distance from the probe's start to the reference position [mm] (beyond the 2.0 mm over
-        which the study's probe is loaded).
+        Distance from the probe's start to the reference position [mm]: beyond the moving
+        contact's free travel to its stop on the plate (C6), about 2.35 mm at the contact, so
+        that the forward stroke starts unloaded (the study's probe is loaded over 2.0 mm).
     hold : float
         Time at the reference position [ms].
     """
