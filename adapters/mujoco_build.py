@@ -16,7 +16,14 @@ import mujoco
 import numpy as np
 
 from clearbench.scenarios.bodies import Motion
-from clearbench.scenarios.loads import LinearSpringDamper, Moment, PointForce, TorsionalSpringDamper
+from clearbench.scenarios.loads import (
+    AngleLawLoad,
+    DistanceLawLoad,
+    LinearSpringDamper,
+    Moment,
+    PointForce,
+    TorsionalSpringDamper,
+)
 from clearbench.scenarios.scene import Scene
 
 from .mujoco_geometry import (
@@ -29,6 +36,7 @@ from .mujoco_geometry import (
     shape_geoms,
     smallest_feature_length,
 )
+from .mujoco_laws import LawForces, law_forces
 from .mujoco_settings import (
     ContactParameters,
     MujocoSettings,
@@ -90,6 +98,7 @@ class BuiltModel:
     hinge_springs: list = field(default_factory=list)  # (load, qpos address, sign)
     warnings: list[str] = field(default_factory=list)
     initial_velocity_residual: float = 0.0
+    law_forces: LawForces | None = None  # angle / distance law loads, applied every step
 
 
 def _relative_pose(parent_pose, child_pose) -> tuple[np.ndarray, np.ndarray]:
@@ -216,7 +225,8 @@ def build_model(scene: Scene, settings: MujocoSettings, time_step: float) -> Bui
     hinge_springs = [(load, int(model.joint(f"{body}:hinge").qposadr[0]), sign)
                      for load, body, sign in hinge_springs]
     built = BuiltModel(model, data, topology, body_ids, pair_lookup, contact_body_b, driven,
-                       python_loads, rings, parameters, hinge_springs, warnings)
+                       python_loads, rings, parameters, hinge_springs, warnings,
+                       law_forces=law_forces(scene, model))
     # Preloads are constant motor controls: set after the reset of the initial state.
     controls = [(model.actuator(name).id, value) for name, value in controls]
     _set_initial_state(built, scene, controls)
@@ -303,7 +313,8 @@ def _add_closure(spec, scene: Scene, joint, poses, settings: MujocoSettings,
 def _add_loads(spec, scene: Scene, topology: Topology, poses, spec_bodies, warnings,
                time_step: float):
     """Springs as tendons / joint stiffness, preloads as motor actuators; point forces,
-    moments and other torsional springs as Python loads applied every step."""
+    moments and other torsional springs as Python loads applied every step (law loads are
+    left to :func:`.mujoco_laws.law_forces`)."""
     python_loads: list[PythonLoad] = []
     controls: list[tuple[str, float]] = []
     hinge_springs: list[tuple] = []
@@ -351,6 +362,8 @@ def _add_loads(spec, scene: Scene, topology: Topology, poses, spec_bodies, warni
                 controls.append((actuator.name, -sign * load.preload))
         elif isinstance(load, PointForce | Moment):
             python_loads.append(PythonLoad(load, -1))
+        elif isinstance(load, AngleLawLoad | DistanceLawLoad):
+            continue  # evaluated by the reference's force function (mujoco_laws)
         else:  # pragma: no cover - every load kind is handled above
             raise TypeError(f"unhandled load kind {load.kind!r}")
     return python_loads, controls, hinge_springs

@@ -3,12 +3,23 @@ large) or unsupported (why). Pure Python: stated without compiling a model."""
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
+
 from clearbench.scenarios.bodies import Motion
+from clearbench.scenarios.quaternion import quat_multiply, quat_to_matrix
 from clearbench.scenarios.scene import Scene
-from clearbench.scenarios.shapes import Arc, Circle, Plane
+from clearbench.scenarios.shapes import Arc, Bore, Circle, Cylinder, Disc, Plane, Rectangle
 
 from .base import Capability, Support
-from .mujoco_geometry import ring_piece_radius
+from .mujoco_geometry import (
+    bore_piece_count,
+    bore_radius_error,
+    face_thickness,
+    ring_piece_radius,
+)
+from .mujoco_laws import law_load_problems
 from .mujoco_settings import (
     MujocoSettings,
     damping_ratio_for_restitution,
@@ -78,11 +89,82 @@ def clearance_summary(scene: Scene, settings: MujocoSettings) -> list[str]:
     return out
 
 
+def _axis_world(scene: Scene, body_name: str, shape) -> np.ndarray:
+    """World direction of a shape's z axis in the initial pose."""
+    body = scene.expanded.body(body_name)
+    q = quat_multiply(np.asarray(body.orientation, dtype=float),
+                      np.asarray(shape.orientation, dtype=float))
+    return quat_to_matrix(q / np.linalg.norm(q))[:, 2]
+
+
+def bore_summary(scene: Scene, settings: MujocoSettings) -> list[str]:
+    """One line per bore: boxes, radius error of their polygon [scene L], and for every pair
+    with a coaxial cylinder inside (a journal) the nominal radial clearance c = R - r - offset,
+    the clearance error c (1/cos(step/2) - 1) and, plainly, whether the polygon's radius error
+    exceeds c."""
+    out = []
+    unit = scene.units.length
+    expanded = scene.expanded
+    for body in expanded.bodies:
+        for shape in body.shapes:
+            if not isinstance(shape, Bore):
+                continue
+            pieces = bore_piece_count(shape, settings)
+            error = bore_radius_error(shape, settings)
+            span = math.degrees(shape.end_angle - shape.start_angle)
+            line = (f"{body.name}/{shape.name}: R {shape.radius:.6g} {unit} over {span:.4g} deg "
+                    f"as {pieces} boxes (half thickness {settings.bore_wall * shape.radius:.3g} "
+                    f"{unit}), radius error up to {error:.3g} {unit} at the polygon's corners")
+            axis = _axis_world(scene, body.name, shape)
+            for contact in expanded.contacts:
+                sides = {(contact.body_a, contact.shape_a), (contact.body_b, contact.shape_b)}
+                if (body.name, shape.name) not in sides:
+                    continue
+                other_body, other_name = next(iter(sides - {(body.name, shape.name)}))
+                partner = expanded.body(other_body).shape(other_name)
+                if not isinstance(partner, Cylinder):
+                    line += f"; pair {contact.name}: partner a {partner.kind}, no clearance"
+                    continue
+                if abs(abs(float(axis @ _axis_world(scene, other_body, partner))) - 1) > 1e-6:
+                    line += f"; pair {contact.name}: cylinder not coaxial, no clearance"
+                    continue
+                clearance = shape.radius - partner.radius - contact.offset
+                step = (shape.end_angle - shape.start_angle) / pieces
+                extra = clearance * (1.0 / math.cos(0.5 * step) - 1.0)
+                line += (f"; pair {contact.name}: radial clearance {clearance:.4g} {unit}, the "
+                         f"journal gains at most {extra:.3g} {unit} "
+                         f"({100 * extra / clearance:.3g} % of it) between two boxes")
+                if error > clearance:
+                    line += (f"; THE POLYGON ERROR {error:.3g} {unit} EXCEEDS THIS CLEARANCE "
+                             f"{clearance:.4g} {unit}")
+                else:
+                    line += (f", radius error {100 * error / clearance:.3g} % of the "
+                             "clearance")
+            out.append(line)
+    return out
+
+
+def face_summary(scene: Scene, settings: MujocoSettings, kind: type) -> list[str]:
+    """One line per rectangle / disc: the thickness of the solid standing in for it."""
+    out = []
+    unit = scene.units.length
+    for body in scene.expanded.bodies:
+        for shape in body.shapes:
+            if isinstance(shape, kind):
+                source = "its depth" if shape.depth is not None else \
+                    f"{settings.face_thickness:g} x its size"
+                out.append(f"{body.name}/{shape.name}: {face_thickness(shape, settings):.3g} "
+                           f"{unit} ({source})")
+    return out
+
+
 def mujoco_capabilities(scene: Scene, settings: MujocoSettings) -> dict[str, Capability]:
     """Capability of every feature in ``scene.features``."""
     topology = plan_topology(scene)
     problems: dict[str, list[str]] = {}
     for feature, reason in topology.problems:
+        problems.setdefault(feature, []).append(reason)
+    for feature, reason in law_load_problems(scene):
         problems.setdefault(feature, []).append(reason)
     closures = set(topology.closures)
     joint_kind = {j.name: j.kind for j in scene.joints}
@@ -137,6 +219,24 @@ def _feature(feature, scene, settings, topology, closures, joint_kind, moving_pl
                     f"static) a cube of half size {settings.plane_box_size:g} x the scene "
                     f"size whose face is the plane: {', '.join(moving_planes)}")
             return _native("MuJoCo plane")
+        if kind == "rectangle":
+            return _approx("box whose +z face is the rectangle, as thick as the shape's depth "
+                           f"(else {settings.face_thickness:g} x its larger half extent); its "
+                           "edges and sides collide too (the scene's rectangle contacts on "
+                           "its face only): " + "; ".join(face_summary(scene, settings,
+                                                                        Rectangle)))
+        if kind == "disc":
+            return _approx("cylinder whose +z end cap is the disc, as thick as the shape's "
+                           f"depth (else {settings.face_thickness:g} x its radius); its rim "
+                           "and edge collide too: " + "; ".join(face_summary(scene, settings,
+                                                                              Disc)))
+        if kind == "bore":
+            return _approx(
+                f"MuJoCo geoms are convex: {settings.bore_pieces} boxes per full circle line "
+                "the hole, their inner faces the circumscribed polygon (apothem R), so the "
+                "hole is up to R (1/cos(pi/N) - 1) larger at the corners; the boxes' end faces "
+                "collide too (beyond the bore's angles and length): "
+                + "; ".join(bore_summary(scene, settings)))
         if kind in ("circle", "arc"):
             return _approx(f"ring of {settings.ring_pieces} {settings.ring_piece}s per full "
                            "circle: " + "; ".join(ring_summary(scene, settings)))
@@ -175,6 +275,10 @@ def _feature(feature, scene, settings, topology, closures, joint_kind, moving_pl
         return _approx("joint stiffness/damping where a tree hinge joins the two bodies about "
                        "the spring axis (exact); otherwise an explicit moment from the "
                        "relative rotation, applied before every step")
+    if feature in ("angle_law_loads", "distance_law_loads"):
+        return _approx("explicit, one step lag: the reference solver's own force function "
+                       "(ref_solver.forces.element_forces) evaluated at the configuration of "
+                       "each step start, applied as xfrc_applied during the step")
     if feature in ("point_forces", "moments"):
         return _native("xfrc_applied at the centre of mass (with the moment of the offset), "
                        "set before every step")

@@ -12,6 +12,11 @@ plane      plane on a fixed body; on a moving body (MuJoCo planes must be static
 circle     ring of N small spheres centred on the circle (default), or of N capsules /
            boxes whose inner surface is the circumscribed N-gon
 arc        the pieces of that ring that cover the arc (spheres: both end points)
+rectangle  box whose +z face is the rectangle, as deep as the shape's ``depth`` (else
+           ``face_thickness`` x its larger half extent); its edges and sides collide too
+disc       cylinder the same way (its rim collides too)
+bore       N boxes lining the hole (MuJoCo geoms are convex): their inner faces form the
+           circumscribed N-gon of the bore (apothem R), over the bore's angles and length
 =========  ==========================================================================
 
 A sphere of radius rho on the circle stands rho proud of it toward every partner; the pair
@@ -32,7 +37,19 @@ import numpy as np
 
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.scene import Scene
-from clearbench.scenarios.shapes import Arc, Box, Capsule, Circle, Cylinder, Plane, Shape, Sphere
+from clearbench.scenarios.shapes import (
+    Arc,
+    Bore,
+    Box,
+    Capsule,
+    Circle,
+    Cylinder,
+    Disc,
+    Plane,
+    Rectangle,
+    Shape,
+    Sphere,
+)
 
 from .mujoco_settings import MujocoSettings, ring_chord_error
 
@@ -61,7 +78,8 @@ class GeomSpec:
 
 @dataclass(frozen=True)
 class RingInfo:
-    """How a circle/arc shape was rebuilt: pieces, piece radius and chord error [L]."""
+    """How a circle/arc shape was rebuilt: pieces, piece radius and chord error [L]; for a
+    bore: boxes, their radial half thickness and the polygon's radius error [L]."""
 
     body: str
     shape: str
@@ -183,6 +201,15 @@ def shape_geoms(scene: Scene, body_name: str, shape: Shape, settings: MujocoSett
         half = settings.plane_box_size * length_scale
         centre = position + quat_to_matrix(orientation) @ np.array([0.0, 0.0, -half])
         return [geom("box", (half, half, half), pos=centre)], None
+    if isinstance(shape, Rectangle | Disc):
+        thickness = face_thickness(shape, settings)
+        centre = position + quat_to_matrix(orientation) @ np.array([0.0, 0.0, -0.5 * thickness])
+        if isinstance(shape, Rectangle):
+            size = (*shape.half_extents, 0.5 * thickness)
+            return [geom("box", size, pos=centre)], None
+        return [geom("cylinder", (shape.radius, 0.5 * thickness), pos=centre)], None
+    if isinstance(shape, Bore):
+        return _bore_geoms(body_name, shape, settings, geom, position, orientation)
     if isinstance(shape, Circle | Arc):
         return _ring_geoms(scene, body_name, shape, settings, geom, position, orientation)
     raise TypeError(f"unhandled shape kind {shape.kind!r}")  # pragma: no cover
@@ -226,6 +253,56 @@ def _ring_geoms(scene: Scene, body_name: str, shape: Circle | Arc, settings: Muj
     full_circle_pieces = round(2.0 * math.pi / step)
     chord = ring_chord_error(shape.radius, full_circle_pieces, settings.ring_piece)
     return out, RingInfo(body_name, shape.name, shape.radius, len(out), rho, chord)
+
+
+def face_thickness(shape: Rectangle | Disc, settings: MujocoSettings) -> float:
+    """Thickness of the solid standing in for a bounded plane face [L]: its ``depth``, else
+    ``face_thickness`` times its larger half extent (a disc: its radius)."""
+    if shape.depth is not None:
+        return float(shape.depth)
+    size = max(shape.half_extents) if isinstance(shape, Rectangle) else shape.radius
+    return settings.face_thickness * float(size)
+
+
+def bore_piece_count(shape: Bore, settings: MujocoSettings) -> int:
+    """Boxes lining ``shape``: ``bore_pieces`` per full circle, rounded up over its angles."""
+    fraction = (shape.end_angle - shape.start_angle) / (2.0 * math.pi)
+    return max(1, math.ceil(settings.bore_pieces * fraction - 1e-9))
+
+
+def bore_radius_error(shape: Bore, settings: MujocoSettings) -> float:
+    """Largest distance between the bore's circle and its polygon of boxes [L]: the inner faces
+    are tangent to the circle (apothem R), the corners stand R (1/cos(step/2) - 1) outside it,
+    step the angle one box spans (at most 2 pi / bore_pieces)."""
+    step = (shape.end_angle - shape.start_angle) / bore_piece_count(shape, settings)
+    return shape.radius * (1.0 / math.cos(0.5 * step) - 1.0)
+
+
+def _bore_geoms(body_name: str, shape: Bore, settings: MujocoSettings, geom, position,
+                orientation) -> tuple[list[GeomSpec], RingInfo]:
+    """Boxes whose inner faces are the circumscribed polygon of the bore (apothem R): box k
+    spans the angles start + k step .. start + (k + 1) step, the bore's length axially and
+    2 ``bore_wall`` R radially; its chord is the polygon edge extended to the outer face, so
+    neighbours meet there and leave no gap (the extensions lie in the neighbour's material,
+    outside the polygon)."""
+    pieces = bore_piece_count(shape, settings)
+    step = (shape.end_angle - shape.start_angle) / pieces
+    wall = settings.bore_wall * shape.radius  # radial half thickness
+    half_chord = (shape.radius + 2.0 * wall) * math.tan(0.5 * step)
+    rotation = quat_to_matrix(orientation)
+    prefix = f"{body_name}/{shape.name}"
+    out = []
+    for k in range(pieces):
+        angle = shape.start_angle + (k + 0.5) * step
+        radial = np.array([math.cos(angle), math.sin(angle), 0.0])
+        tangent = np.array([-math.sin(angle), math.cos(angle), 0.0])
+        # Box axes: x radial (outward), y = -bore axis, z along the chord (right-handed).
+        local = np.column_stack([radial, [0.0, 0.0, -1.0], tangent])
+        centre = position + rotation @ ((shape.radius + wall) * radial)
+        out.append(geom("box", (wall, shape.half_length, half_chord), name=f"{prefix}#{k}",
+                        pos=centre, quat=matrix_to_quat(rotation @ local)))
+    return out, RingInfo(body_name, shape.name, shape.radius, pieces, wall,
+                         bore_radius_error(shape, settings))
 
 
 @dataclass(frozen=True)

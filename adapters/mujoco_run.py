@@ -31,7 +31,7 @@ logger = logging.getLogger(__name__)
 #: Expectation kinds under which the energy of the scene may not grow.
 ENERGY_EXPECTATIONS = ("energy_non_increasing", "energy_conserved")
 #: Features that do work the energy bookkeeping does not count (the guard stays off).
-WORK_FEATURES = ("drivers", "point_forces", "moments")
+WORK_FEATURES = ("drivers", "point_forces", "moments", "angle_law_loads", "distance_law_loads")
 
 
 def profile_integral(times, values, t) -> np.ndarray:
@@ -246,12 +246,15 @@ class Runner:
 
     # ------------------------------------------------------------------ loads
     def apply_loads(self) -> None:
-        """xfrc_applied of point forces, moments and explicit torsional springs at the state
-        of the step start (kinematics from mj_step1)."""
+        """xfrc_applied of point forces, moments, explicit torsional springs and law loads at
+        the state of the step start (kinematics from mj_step1)."""
         d = self.data
-        if not self.built.python_loads:
+        laws = self.built.law_forces
+        if not self.built.python_loads and laws is None:
             return
         d.xfrc_applied[:] = 0.0
+        if laws is not None:
+            laws.apply(d)
         t = d.time
         for item in self.built.python_loads:
             load = item.load

@@ -89,6 +89,14 @@ class MujocoSettings:
     ring_piece_radius : float
         Radius (sphere, capsule) or half thickness (box) of a ring piece, relative to the
         ring radius; capped at half the radial clearance for clearance-joint rings.
+    bore_pieces : int
+        Boxes per full circle lining a bore (a concave cylinder: MuJoCo geoms are convex);
+        their inner faces form the circumscribed polygon of the bore.
+    bore_wall : float
+        Radial half thickness of a bore's boxes, relative to the bore radius.
+    face_thickness : float
+        Thickness of the box (rectangle) or cylinder (disc) standing in for a bounded plane face
+        that gives no ``depth``, relative to its larger half extent (or radius).
     plane_box_size : float
         Half size of the box that stands in for a plane on a moving body (MuJoCo planes must be
         static), relative to the scene's largest length.
@@ -132,6 +140,9 @@ class MujocoSettings:
     ring_pieces: int = 64
     ring_piece: str = "sphere"
     ring_piece_radius: float = 0.01
+    bore_pieces: int = 64
+    bore_wall: float = 0.05
+    face_thickness: float = 0.1
     plane_box_size: float = 100.0
     closure_spacing: float | None = None
     driver_armature_ratio: float = 1e6
@@ -163,11 +174,12 @@ class MujocoSettings:
             if len(value) != 5:
                 raise ValueError(f"mujoco option {name}={value!r}: needs 5 numbers")
             object.__setattr__(self, name, value)
-        if self.ring_pieces < 3:
-            raise ValueError(f"mujoco option ring_pieces={self.ring_pieces}: must be >= 3")
+        for name in ("ring_pieces", "bore_pieces"):
+            if getattr(self, name) < 3:
+                raise ValueError(f"mujoco option {name}={getattr(self, name)}: must be >= 3")
         positive = ("impratio", "tolerance", "restitution_contact_steps", "plastic_damping_ratio",
-                    "ring_piece_radius", "plane_box_size", "driver_armature_ratio",
-                    "energy_gain_tolerance")
+                    "ring_piece_radius", "bore_wall", "face_thickness", "plane_box_size",
+                    "driver_armature_ratio", "energy_gain_tolerance")
         for name in positive:
             if not getattr(self, name) > 0:
                 raise ValueError(f"mujoco option {name}={getattr(self, name)!r}: must be > 0")
