@@ -227,6 +227,8 @@ def build_model(scene: Scene, settings: MujocoSettings, time_step: float) -> Bui
     built = BuiltModel(model, data, topology, body_ids, pair_lookup, contact_body_b, driven,
                        python_loads, rings, parameters, hinge_springs, warnings,
                        law_forces=law_forces(scene, model))
+    if built.law_forces is not None:
+        built.law_forces.wrenches(data)  # compile / load the numba function outside stepping
     # Preloads are constant motor controls: set after the reset of the initial state.
     controls = [(model.actuator(name).id, value) for name, value in controls]
     _set_initial_state(built, scene, controls)
@@ -260,10 +262,12 @@ def _add_tree_joints(body_spec, link, scene: Scene, poses) -> None:
     if link.kind == "free":
         body_spec.add_freejoint(name=f"{link.body}:free")
         return
-    if link.kind == "translation_driven":
+    if link.kind in ("translation_driven", "translation_driven_held"):
         for k, axis in enumerate("xyz"):
             body_spec.add_joint(name=f"{link.body}:slide_{axis}", type=JOINT_TYPES["slide"],
                                 axis=rotation.T @ np.eye(3)[k])
+        if link.kind == "translation_driven_held":
+            return
         com = np.asarray(scene.body(link.body).center_of_mass, dtype=float)
         body_spec.add_joint(name=f"{link.body}:ball", type=JOINT_TYPES["ball"], pos=com)
         return

@@ -58,7 +58,8 @@ def describe_plastic(settings: MujocoSettings) -> str:
 
 
 def ring_summary(scene: Scene, settings: MujocoSettings) -> list[str]:
-    """One line per circle/arc shape: pieces, piece radius and chord error [scene L]."""
+    """One line per circle/arc shape: pieces, piece radius and chord error [scene L], and for
+    every pair with a journal inside, the chord error next to its radial clearance."""
     out = []
     unit = scene.units.length
     for body in scene.expanded.bodies:
@@ -66,9 +67,16 @@ def ring_summary(scene: Scene, settings: MujocoSettings) -> list[str]:
             if isinstance(shape, Circle | Arc):
                 rho = ring_piece_radius(scene, body.name, shape, settings)
                 chord = ring_chord_error(shape.radius, settings.ring_pieces, settings.ring_piece)
-                out.append(f"{body.name}/{shape.name}: R {shape.radius:.6g} {unit}, "
-                           f"{settings.ring_piece}s of radius {rho:.3g} {unit}, chord error "
-                           f"{chord:.3g} {unit}")
+                line = (f"{body.name}/{shape.name}: R {shape.radius:.6g} {unit}, "
+                        f"{settings.ring_piece}s of radius {rho:.3g} {unit}, chord error "
+                        f"{chord:.3g} {unit}")
+                for name, clearance in journal_clearances(scene, body.name, shape):
+                    if clearance is not None and clearance > 0:
+                        extra = ring_clearance_error(shape.radius, clearance,
+                                                     settings.ring_pieces, settings.ring_piece)
+                        line += f"; pair {name}: " + _clearance_words(chord, extra, clearance,
+                                                                       unit)
+                out.append(line)
     return out
 
 
@@ -97,49 +105,58 @@ def _axis_world(scene: Scene, body_name: str, shape) -> np.ndarray:
     return quat_to_matrix(q / np.linalg.norm(q))[:, 2]
 
 
+def journal_clearances(scene: Scene, body_name: str, shape) -> list[tuple[str, float | None]]:
+    """(pair name, nominal radial clearance R - r - offset [L]) of every pair of a circle, arc
+    or bore with a coaxial cylinder of smaller radius inside it (a journal); None for the
+    pairs of other partners (no clearance to speak of)."""
+    expanded = scene.expanded
+    axis = _axis_world(scene, body_name, shape)
+    out = []
+    for contact in expanded.contacts:
+        sides = [(contact.body_a, contact.shape_a), (contact.body_b, contact.shape_b)]
+        if (body_name, shape.name) not in sides:
+            continue
+        other_body, other_name = next(side for side in sides if side != (body_name, shape.name))
+        partner = expanded.body(other_body).shape(other_name)
+        coaxial = isinstance(partner, Cylinder) and partner.radius < shape.radius and abs(
+            abs(float(axis @ _axis_world(scene, other_body, partner))) - 1.0) < 1e-6
+        out.append((contact.name, shape.radius - partner.radius - contact.offset
+                    if coaxial else None))
+    return out
+
+
+def _clearance_words(error: float, extra: float, clearance: float, unit: str) -> str:
+    words = (f"radial clearance {clearance:.4g} {unit}: the journal gains at most "
+             f"{extra:.3g} {unit} ({100 * extra / clearance:.3g} % of it) between two pieces")
+    if error > clearance:
+        return words + (f"; THE POLYGON ERROR {error:.3g} {unit} EXCEEDS THIS CLEARANCE "
+                        f"{clearance:.4g} {unit}")
+    return words + f", the shape error is {100 * error / clearance:.3g} % of it"
+
+
 def bore_summary(scene: Scene, settings: MujocoSettings) -> list[str]:
     """One line per bore: boxes, radius error of their polygon [scene L], and for every pair
-    with a coaxial cylinder inside (a journal) the nominal radial clearance c = R - r - offset,
-    the clearance error c (1/cos(step/2) - 1) and, plainly, whether the polygon's radius error
-    exceeds c."""
+    with a journal inside the nominal radial clearance c, the clearance error
+    c (1/cos(step/2) - 1) and, plainly, whether the polygon's radius error exceeds c."""
     out = []
     unit = scene.units.length
-    expanded = scene.expanded
-    for body in expanded.bodies:
+    for body in scene.expanded.bodies:
         for shape in body.shapes:
             if not isinstance(shape, Bore):
                 continue
             pieces = bore_piece_count(shape, settings)
             error = bore_radius_error(shape, settings)
+            step = (shape.end_angle - shape.start_angle) / pieces
             span = math.degrees(shape.end_angle - shape.start_angle)
             line = (f"{body.name}/{shape.name}: R {shape.radius:.6g} {unit} over {span:.4g} deg "
                     f"as {pieces} boxes (half thickness {settings.bore_wall * shape.radius:.3g} "
                     f"{unit}), radius error up to {error:.3g} {unit} at the polygon's corners")
-            axis = _axis_world(scene, body.name, shape)
-            for contact in expanded.contacts:
-                sides = {(contact.body_a, contact.shape_a), (contact.body_b, contact.shape_b)}
-                if (body.name, shape.name) not in sides:
+            for name, clearance in journal_clearances(scene, body.name, shape):
+                if clearance is None:
+                    line += f"; pair {name}: no journal inside, no clearance"
                     continue
-                other_body, other_name = next(iter(sides - {(body.name, shape.name)}))
-                partner = expanded.body(other_body).shape(other_name)
-                if not isinstance(partner, Cylinder):
-                    line += f"; pair {contact.name}: partner a {partner.kind}, no clearance"
-                    continue
-                if abs(abs(float(axis @ _axis_world(scene, other_body, partner))) - 1) > 1e-6:
-                    line += f"; pair {contact.name}: cylinder not coaxial, no clearance"
-                    continue
-                clearance = shape.radius - partner.radius - contact.offset
-                step = (shape.end_angle - shape.start_angle) / pieces
                 extra = clearance * (1.0 / math.cos(0.5 * step) - 1.0)
-                line += (f"; pair {contact.name}: radial clearance {clearance:.4g} {unit}, the "
-                         f"journal gains at most {extra:.3g} {unit} "
-                         f"({100 * extra / clearance:.3g} % of it) between two boxes")
-                if error > clearance:
-                    line += (f"; THE POLYGON ERROR {error:.3g} {unit} EXCEEDS THIS CLEARANCE "
-                             f"{clearance:.4g} {unit}")
-                else:
-                    line += (f", radius error {100 * error / clearance:.3g} % of the "
-                             "clearance")
+                line += f"; pair {name}: " + _clearance_words(error, extra, clearance, unit)
             out.append(line)
     return out
 
@@ -288,7 +305,8 @@ def _feature(feature, scene, settings, topology, closures, joint_kind, moving_pl
     if feature == "drivers":
         return _approx(
             "each driven component is a joint of the body (hinge / slide to a fixed body, or "
-            "world slides) with armature "
+            "world slides; a body whose three rotations are held at zero has no rotational "
+            "freedom at all, exact) with armature "
             f"{settings.driver_armature_ratio:g} x its inertia, position and velocity reset to "
             "the profile before every step (exact at step starts; reactions from the "
             "dynamics). Not mocap bodies: MuJoCo gives them no velocity, so contacts and "

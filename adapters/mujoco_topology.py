@@ -19,7 +19,9 @@ Bodies joined to no fixed body get a free joint. A driven body needs each prescr
 to be one degree of freedom of its own joints, which is the case for (a) a hinge (slide) to a
 fixed body about (along) the world axis of its one driven component, or (b) a body with no
 tree joint driven in translation only: it gets slides along world x, y, z and a ball joint at
-its centre of mass. Pure Python: no ``mujoco`` import.
+its centre of mass, or (c) such a body whose three rotations are driven and held at zero: the
+slides only (its orientation cannot change, exactly as prescribed). Pure Python: no ``mujoco``
+import.
 """
 
 from __future__ import annotations
@@ -55,7 +57,9 @@ class TreeLink:
     """How one scene body enters the MuJoCo tree.
 
     kind: 'static' (fixed body, child of the world, no joint), 'free' (free joint),
-    'translation_driven' (slides x, y, z + ball at the centre of mass), 'hinge', 'slide',
+    'translation_driven' (slides x, y, z + ball at the centre of mass),
+    'translation_driven_held' (slides x, y, z only: every rotation is driven and held at zero,
+    so the orientation stays exactly the initial one), 'hinge', 'slide',
     'ball' or 'weld' (tree joint ``joint`` to ``parent``).
     """
 
@@ -149,10 +153,13 @@ def plan_topology(scene: Scene) -> Topology:
     for body in scene.bodies:
         if body.name not in visited:
             visited.add(body.name)
-            driven_root = body.motion is Motion.DRIVEN and not any(
-                d.is_rotation for d in drivers_of.get(body.name, ()))
-            links.append(TreeLink(body.name, None,
-                                  "translation_driven" if driven_root else "free"))
+            rotations = [d for d in drivers_of.get(body.name, ()) if d.is_rotation]
+            kind = "free"
+            if body.motion is Motion.DRIVEN and not rotations:
+                kind = "translation_driven"
+            elif body.motion is Motion.DRIVEN and rotations_held(rotations):
+                kind = "translation_driven_held"
+            links.append(TreeLink(body.name, None, kind))
             visit_from(body.name)
 
     problems = []
@@ -167,6 +174,13 @@ def plan_topology(scene: Scene) -> Topology:
                     tuple(ignored))
 
 
+def rotations_held(rotations: list[Driver]) -> bool:
+    """True when the three rotation components are all driven and each profile is zero
+    throughout (the body keeps its initial orientation)."""
+    return len({d.component for d in rotations}) == 3 and all(
+        not any(d.values) for d in rotations)
+
+
 def _plan_drivers(scene: Scene, links: list, fixed: set, drivers_of: dict):
     joints = {j.name: j for j in scene.joints}
     by_body = {link.body: link for link in links}
@@ -175,8 +189,10 @@ def _plan_drivers(scene: Scene, links: list, fixed: set, drivers_of: dict):
     for body, drivers in drivers_of.items():
         link = by_body[body]
         components = ", ".join(d.component for d in drivers)
-        if link.kind == "translation_driven":
-            driven[body] = tuple(DrivenDof(d, f"slide_{d.component}") for d in drivers)
+        if link.kind in ("translation_driven", "translation_driven_held"):
+            # Held rotations have no joint: the orientation cannot change (exact).
+            driven[body] = tuple(DrivenDof(d, f"slide_{d.component}") for d in drivers
+                                 if not d.is_rotation)
             continue
         if link.kind in ("hinge", "slide") and link.parent in fixed and len(drivers) == 1:
             driver = drivers[0]
@@ -194,6 +210,7 @@ def _plan_drivers(scene: Scene, links: list, fixed: set, drivers_of: dict):
             "drivers",
             f"body {body!r} (drivers on {components}): MuJoCo can prescribe a component only as "
             "its own joint: one rotation (translation) by a hinge (slide) to a fixed body "
-            "about (along) that world axis, or translations of a body with no ideal joint",
+            "about (along) that world axis, or translations of a body with no ideal joint (its "
+            "rotations undriven, or all three held at zero)",
         ))
     return driven, problems

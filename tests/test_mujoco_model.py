@@ -28,14 +28,13 @@ def _rotation(q) -> np.ndarray:
     return quat_to_matrix(np.asarray(q, dtype=float) / np.linalg.norm(q))
 
 
-# Scenes MuJoCo can build: every library scene except the C-60 ones, whose law loads, bores and
-# bounded faces the adapter does not map yet (they get an explicit unsupported verdict).
+# Scenes MuJoCo can build: every library scene, the C-60 included (law loads, bores and
+# bounded faces approximated, see test_mujoco_c60.py).
 SUPPORTED = [n for n in NAMES if not create("default").unsupported_reasons(get_scene(n))]
 
 
-def test_only_the_c60_scenes_are_unsupported():
-    unsupported = set(NAMES) - set(SUPPORTED)
-    assert all("c60" in get_scene(n).tags for n in unsupported), sorted(unsupported)
+def test_every_library_scene_is_supported():
+    assert set(SUPPORTED) == set(NAMES), sorted(set(NAMES) - set(SUPPORTED))
 
 
 @pytest.mark.parametrize("name", SUPPORTED)
