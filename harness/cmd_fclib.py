@@ -46,9 +46,9 @@ def register(subparsers) -> None:
     parser.add_argument("--repeat", type=int, default=3,
                         help="solves per (problem, solver), at least; the fastest time is kept "
                              "(default 3)")
-    parser.add_argument("--min-time", type=float, default=0.05,
+    parser.add_argument("--min-time", type=float, default=0.2,
                         help="repeat faster solves (ours and Siconos's, up to 1000 times) until "
-                             "they total this many seconds (default 0.05)")
+                             "they total this many seconds (default 0.2)")
     parser.add_argument("--timeout", type=float, default=300.0,
                         help="wall-clock limit of one Siconos worker, seconds (default 300)")
     parser.add_argument("--no-siconos", action="store_true", help="do not run Siconos")

@@ -58,7 +58,7 @@ class CompareSettings:
     max_newton: int = 500
     repeat: int = 3
     timeout: float = 300.0
-    min_time: float = 0.05
+    min_time: float = 0.2
 
 
 #: Cap on the solves of one timing (the Siconos worker has the same cap).
