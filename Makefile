@@ -61,4 +61,5 @@ clean:
 # numba's on-disk cache does not notice edits to a compiled function's callees (an inlined
 # kernel edited in another module): after editing numba kernels, drop the caches.
 clean-numba-cache:
-	find . -path ./$(VENV) -prune -o \( -name '*.nbi' -o -name '*.nbc' \) -print -delete
+	find . -not -path './$(VENV)/*' \( -name '*.nbi' -o -name '*.nbc' \) -delete
+	rm -rf $${XDG_CACHE_HOME:-$$HOME/.cache}/clearbench-numba

@@ -4,6 +4,54 @@ The sub-packages live in top-level folders of the repository and are installed u
 namespace: ``clearbench.scenarios`` (engine-neutral scenes, geometry, analytic references),
 ``clearbench.ref_solver`` (our nonsmooth Moreau--Jean solver), ``clearbench.adapters`` (one
 module per engine) and ``clearbench.harness`` (runner, metrics, store, report, CLI).
+
+Importing the package points numba's on-disk cache (``NUMBA_CACHE_DIR``, unless the user set
+it) at a directory named after the state of the package's sources. numba keys a cached kernel
+on its own file only: a kernel that inlines a function from another module would otherwise keep
+running the old code after that module is edited (it did once, and hid a fix).
 """
 
+import hashlib
+import importlib.util
+import os
+import shutil
+from pathlib import Path
+
 __version__ = "0.1.0"
+
+_SUBPACKAGES = ("clearbench.scenarios", "clearbench.ref_solver", "clearbench.adapters",
+                "clearbench.harness")
+
+
+def _sources_fingerprint() -> str:
+    """Digest of the path, size and modification time of every source file [hex, 16 chars]."""
+    digest = hashlib.sha1(__version__.encode())
+    for name in _SUBPACKAGES:
+        spec = importlib.util.find_spec(name)
+        for location in (spec.submodule_search_locations or []) if spec else []:
+            for path in sorted(Path(location).glob("*.py")):
+                stat = path.stat()
+                digest.update(f"{path}:{stat.st_size}:{stat.st_mtime_ns}\n".encode())
+    return digest.hexdigest()[:16]
+
+
+#: Cache directories of earlier source states kept besides the current one.
+_KEEP_CACHES = 4
+
+
+def _set_numba_cache_dir() -> None:
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        return
+    root = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "clearbench-numba"
+    current = root / _sources_fingerprint()
+    os.environ["NUMBA_CACHE_DIR"] = str(current)
+    try:
+        older = sorted((d for d in root.iterdir() if d != current),
+                       key=lambda d: d.stat().st_mtime, reverse=True)
+    except OSError:  # no cache yet
+        return
+    for stale in older[_KEEP_CACHES:]:
+        shutil.rmtree(stale, ignore_errors=True)
+
+
+_set_numba_cache_dir()

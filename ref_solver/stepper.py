@@ -46,6 +46,10 @@ from .gyroscopic import gyroscopic_update, integrate_orientations
 from .projection import solve_projection
 from .system import MultibodySystem, State
 
+#: Halvings of a projection correction that does not reduce the largest violation before the
+#: projection gives up (a correction scaled by 2^-8 that still does not help is not a descent).
+MAX_PROJECTION_HALVINGS = 8
+
 
 @dataclass(frozen=True)
 class StepperSettings:
@@ -490,54 +494,93 @@ class MoreauJeanStepper:
                                                                               bool]:
         """Project positions onto the joint, driver and active-contact constraints in place.
 
+        Gauss–Newton on the constraints with the projection metric, globalised by halving the
+        correction until the largest violation decreases. Contacts that carry a normal impulse
+        are equalities g = 0 (eq. 21 of the study); when that set of equalities cannot be met
+        (redundant contacts closed with impulse whose gaps are not compatible, as two bearing
+        rings and a flange of a tilted journal can be) the projection is restarted with those
+        contacts unilateral (g >= 0). If it still fails, the least violating configuration
+        reached is kept, and the step is reported unconverged.
+
         Returns (iterations, largest remaining violation [L], converged)."""
+        start_x, start_p = state.x.copy(), state.p.copy()
+        iterations, worst, converged = self._project(state, active, closed)
+        if converged or not closed.any():
+            return iterations, worst, converged
+        best = (worst, state.x.copy(), state.p.copy())
+        state.x[:], state.p[:] = start_x, start_p
+        more, worst, converged = self._project(state, active, np.zeros_like(closed))
+        iterations += more
+        if not converged and best[0] < worst:
+            worst = best[0]
+            state.x[:], state.p[:] = best[1], best[2]
+        return iterations, worst, converged
+
+    def _violations(self, state: State, active, closed):
+        """Rows of the projection at ``state``: (row_body, row_coef, values, n_equal, worst).
+
+        Equalities first (joints, drivers, contacts that carry impulse), then the unilateral
+        contact rows; ``worst`` is the largest violation [L]."""
+        nbil = self.system.bilateral_row_count
+        rotation = rotation_matrices(state.p)
+        cand = self._candidates(state.x, rotation)
+        row_body, row_coef, violation, _, pairs, slots = self._rows(
+            state.t, state.x, state.p, rotation, cand, active)
+        keep = np.ones(row_body.shape[0], dtype=bool)
+        # Contacts: only the normal rows take part in the projection.
+        if len(pairs):
+            contact_part = np.zeros(3 * len(pairs), dtype=bool)
+            contact_part[0::3] = True
+            keep[nbil:] = contact_part
+        # Eq. (21) of the study: a contact that transmits a normal impulse (P_N > 0) is
+        # projected to g = 0 (an equality); the others only out of penetration (g >= 0).
+        # Without it a body resting on a contact that closed within the step hovers at the
+        # gap it had (the velocity stage stops it, nothing brings the gap to zero). A
+        # contact whose impulse is a rebound (normal velocity > 0 at the end of the step)
+        # is left unilateral: pulling a bouncing body down to g = 0 would take away the
+        # potential energy of the gap at which the impact was captured.
+        equality = np.arange(len(keep)) < nbil
+        if len(pairs):
+            equality[nbil:][0::3] = closed[pairs, slots]
+        equal = np.nonzero(keep & equality)[0]
+        inequal = np.nonzero(keep & ~equality)[0]
+        rows = np.concatenate((equal, inequal))
+        n_equal = len(equal)
+        values = violation[rows]
+        equal_error = np.max(np.abs(values[:n_equal])) if n_equal else 0.0
+        unilateral_error = max(0.0, -np.min(values[n_equal:])) if len(values) > n_equal \
+            else 0.0
+        return (np.ascontiguousarray(row_body[rows]), np.ascontiguousarray(row_coef[rows]),
+                values, n_equal, max(equal_error, unilateral_error))
+
+    def _project(self, state: State, active, closed) -> tuple[int, float, bool]:
+        """Globalised Gauss–Newton projection (see :meth:`_projection_stage`)."""
         sys_ = self.system
         cfg = self.settings
-        nbil = sys_.bilateral_row_count
-        worst = 0.0
+        row_body, row_coef, values, n_equal, worst = self._violations(state, active, closed)
         for iteration in range(cfg.max_projection_iterations + 1):
-            rotation = rotation_matrices(state.p)
-            cand = self._candidates(state.x, rotation)
-            row_body, row_coef, violation, _, pairs, slots = self._rows(
-                state.t, state.x, state.p, rotation, cand, active)
-            keep = np.ones(row_body.shape[0], dtype=bool)
-            # Contacts: only the normal rows take part in the projection.
-            if len(pairs):
-                contact_part = np.zeros(3 * len(pairs), dtype=bool)
-                contact_part[0::3] = True
-                keep[nbil:] = contact_part
-            # Eq. (21) of the study: a contact that transmits a normal impulse (P_N > 0) is
-            # projected to g = 0 (an equality); the others only out of penetration (g >= 0).
-            # Without it a body resting on a contact that closed within the step hovers at the
-            # gap it had (the velocity stage stops it, nothing brings the gap to zero). A
-            # contact whose impulse is a rebound (normal velocity > 0 at the end of the step)
-            # is left unilateral: pulling a bouncing body down to g = 0 would take away the
-            # potential energy of the gap at which the impact was captured.
-            pushing = np.zeros(row_body.shape[0], dtype=bool)
-            if len(pairs):
-                pushing[nbil:][0::3] = closed[pairs, slots]
-            equal = np.nonzero(keep & ((np.arange(len(keep)) < nbil) | pushing))[0]
-            inequal = np.nonzero(keep & ~((np.arange(len(keep)) < nbil) | pushing))[0]
-            rows = np.concatenate((equal, inequal))
-            n_equal = len(equal)
-            values = violation[rows]
-            equal_error = np.max(np.abs(values[:n_equal])) if n_equal else 0.0
-            unilateral_error = max(0.0, -np.min(values[n_equal:])) if len(values) > n_equal \
-                else 0.0
-            worst = max(equal_error, unilateral_error)
-            if worst <= cfg.position_tolerance or len(rows) == 0:
+            if worst <= cfg.position_tolerance or len(values) == 0:
                 return iteration, worst, True
             if iteration == cfg.max_projection_iterations:
                 break
-            rb = np.ascontiguousarray(row_body[rows])
-            rc = np.ascontiguousarray(row_coef[rows])
-            w, y = delassus(rb, rc, len(rows), self.projection_inverse, *self.single_clusters)
+            w, y = delassus(row_body, row_coef, len(values), self.projection_inverse,
+                            *self.single_clusters)
             # Contacts of the active set that are open keep a zero multiplier.
             solve = solve_projection(w, values, n_equal, 0.1 * cfg.position_tolerance)
             delta = (y @ solve.delta).reshape(-1, 6)
-            state.x += delta[:, :3]
-            state.p[:] = integrate_orientations(state.p, np.ascontiguousarray(delta[:, 3:]),
-                                                sys_.body_fixed)
+            x0, p0 = state.x.copy(), state.p.copy()
+            for _ in range(MAX_PROJECTION_HALVINGS + 1):
+                state.x[:] = x0 + delta[:, :3]
+                state.p[:] = integrate_orientations(p0, np.ascontiguousarray(delta[:, 3:]),
+                                                    sys_.body_fixed)
+                trial = self._violations(state, active, closed)
+                if trial[4] < worst:
+                    break
+                delta *= 0.5
+            else:
+                state.x[:], state.p[:] = x0, p0
+                return iteration + 1, worst, False
+            row_body, row_coef, values, n_equal, worst = trial
         return cfg.max_projection_iterations, worst, False
 
 

@@ -106,6 +106,14 @@ C7 = "Mcontact_Fcontact_bot_1_C7"
 #: concave hollow below the side plane (r 5.9) and the convex fillet (r 0.05) between the planes.
 WEDGE_FACES = ("side", "top", "hollow", "fillet")
 Z_AXIS = (0.0, 0.0, 1.0)
+#: How far the solid behind a plane contact face reaches [mm] (``Rectangle.depth``): a partner
+#: deeper than this has gone round behind the part, it is not in it. Without it the handle,
+#: which turns freely after a trip (the source has no OFF stop), brings its ON-stop face back
+#: round behind the case's stop pins 8.5 mm "deep" at 15.2 ms of c60-trip, and the projection
+#: tears the handle out of its bearing. 0.5 mm is 250x the deepest motion of a contact in one
+#: step (about 2 mm/ms x 1e-3 ms) and below the thickness of the C-60's plates and walls
+#: (about 1 mm; an estimate, not measured on the CAD).
+FACE_DEPTH = 0.5
 
 
 @lru_cache(maxsize=1)
@@ -219,9 +227,10 @@ def _plane_shape(name: str, plane: prim.Plane, toward_world: np.ndarray, pose: P
     if round_face:
         if abs(half_u - half_v) > 1e-9:
             raise ValueError(f"plane {name}: a round face needs a square bounding box")
-        return Disc(name, position=centre, orientation=orientation, radius=half_u)
+        return Disc(name, position=centre, orientation=orientation, radius=half_u,
+                    depth=FACE_DEPTH)
     return Rectangle(name, position=centre, orientation=orientation,
-                     half_extents=(half_u, half_v))
+                     half_extents=(half_u, half_v), depth=FACE_DEPTH)
 
 
 def _round_face(plane: prim.Plane) -> bool:

@@ -65,8 +65,9 @@ circle-cylinder    1   bearing ring against a journal, or ring against a pin (be
 arc-cylinder       1   the same, restricted to the arc's angles (else the better arc end).
 rectangle-X       0-8  X = sphere, cylinder, circle, arc: the plane pair, keeping only the
 disc-X                 candidates whose point on the face lies inside the face (|x| <= half_x,
-                       |y| <= half_y; or x^2 + y^2 <= r^2). A contact that slides off the face
-                       is lost (edges are not modelled). Gap and normal are the plane's.
+                       |y| <= half_y; or x^2 + y^2 <= r^2) and whose gap is not below -depth
+                       (behind the solid, not in it). A contact that slides off the face is
+                       lost (edges are not modelled). Gap and normal are the plane's.
 circle-bore       0-1  ring INSIDE a bore: g = R_bore - (largest distance of a ring point from
 arc-bore               the bore axis), n radially outward from that ring point (parallel axes at
                        eccentricity e: g = R_bore - R_ring - e). Kept only if the point on the
@@ -201,8 +202,8 @@ _PACKED_FIELDS: dict[str, tuple[str, ...]] = {
     "plane": (),
     "circle": ("radius",),
     "arc": ("radius", "start_angle", "end_angle"),
-    "rectangle": ("half_extents",),
-    "disc": ("radius",),
+    "rectangle": ("half_extents", "depth"),
+    "disc": ("radius", "depth"),
     "bore": ("radius", "half_length", "start_angle", "end_angle"),
 }
 
@@ -270,8 +271,8 @@ def pack_shape_parameters(shape: Shape) -> np.ndarray:
     plane     []
     circle    [radius]
     arc       [radius, start_angle, end_angle] (rad)
-    rectangle [half_x, half_y]
-    disc      [radius]
+    rectangle [half_x, half_y, depth] (depth 0: unbounded)
+    disc      [radius, depth] (depth 0: unbounded)
     bore      [radius, half_length, start_angle, end_angle] (rad)
     ========  ============================================
 
@@ -283,6 +284,8 @@ def pack_shape_parameters(shape: Shape) -> np.ndarray:
     values: list[float] = []
     for name in _PACKED_FIELDS[kind]:
         value = getattr(shape, name)
+        if value is None:  # an optional bound (a face's depth, > 0 when given): 0 = unbounded
+            value = 0.0
         values.extend(value if isinstance(value, tuple | list) else (value,))
     packed = np.zeros(PARAMETER_COUNT)
     packed[: len(values)] = values

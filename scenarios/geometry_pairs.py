@@ -838,12 +838,16 @@ def _ring_cylinder(ring_position, ring_rotation, ring_radius, start_angle, span,
 
 
 @njit(cache=True)
-def _keep_inside_face(plane_position, plane_rotation, half_x, half_y, radius, count, stage):
+def _keep_inside_face(plane_position, plane_rotation, half_x, half_y, radius, depth, count,
+                      stage):
     """Keep the staged contacts whose point on A (row 1 of the stage) lies in the face:
     |x| <= half_x and |y| <= half_y (rectangle, radius < 0) or x^2 + y^2 <= radius^2 (disc)
-    in the face's frame. Returns the number kept (compacted to the front, order preserved)."""
+    in the face's frame, and whose gap is not below -depth (depth 0: no bound). Returns the
+    number kept (compacted to the front, order preserved)."""
     kept = 0
     for k in range(count):
+        if depth > 0.0 and stage[k, 2, 0] < -depth:
+            continue
         point = (stage[k, 1, 0], stage[k, 1, 1], stage[k, 1, 2])
         local = _to_local(plane_position, plane_rotation, point)
         if radius >= 0.0:
@@ -978,6 +982,7 @@ def _canonical_contacts(kind_a, params_a, position_a, rotation_a, kind_b, params
         return -1
     if kind_a == RECTANGLE or kind_a == DISC:
         radius = params_a[0] if kind_a == DISC else -1.0
+        depth = params_a[1] if kind_a == DISC else params_a[2]
         if kind_b == SPHERE:
             count = _plane_sphere(position_a, rotation_a, position_b, params_b[0], stage)
         elif kind_b == CYLINDER:
@@ -992,7 +997,7 @@ def _canonical_contacts(kind_a, params_a, position_a, rotation_a, kind_b, params
         else:
             return -1
         return _keep_inside_face(position_a, rotation_a, params_a[0], params_a[1], radius,
-                                 count, stage)
+                                 depth, count, stage)
     if kind_b == SPHERE:
         if kind_a == SPHERE:
             return _sphere_sphere(position_a, params_a[0], position_b, params_b[0], stage)

@@ -159,23 +159,39 @@ def _check_angle_range(shape: Shape) -> None:
 
 @dataclass(frozen=True)
 class Rectangle(Shape):
+    """A bounded plane face: |x| <= half_x, |y| <= half_y in its frame, material below z = 0.
+
+    ``depth`` [L] is how far the solid reaches behind the face: a partner deeper than that has
+    passed behind the solid (a part that turned all the way round), it is not in it, and no
+    contact is reported. None: the whole half-space below the face.
+    """
+
     kind: ClassVar[str] = "rectangle"
     half_extents: tuple[float, float] = field(default=(0.5, 0.5), metadata=dim(LENGTH))
+    depth: float | None = field(default=None, metadata=dim(LENGTH))
 
     def _check_parameters(self) -> None:
         values = check_finite_vector("half_extents", self.half_extents, 2)
         for axis, value in zip("xy", values, strict=True):
             check_positive(f"half_extents.{axis}", value)
         object.__setattr__(self, "half_extents", values)
+        if self.depth is not None:
+            object.__setattr__(self, "depth", check_positive("depth", self.depth))
 
 
 @dataclass(frozen=True)
 class Disc(Shape):
+    """A round plane face of ``radius`` [L] about its frame's z axis, material below z = 0;
+    ``depth`` [L] as for :class:`Rectangle`."""
+
     kind: ClassVar[str] = "disc"
     radius: float = field(default=0.5, metadata=dim(LENGTH))
+    depth: float | None = field(default=None, metadata=dim(LENGTH))
 
     def _check_parameters(self) -> None:
         object.__setattr__(self, "radius", check_positive("radius", self.radius))
+        if self.depth is not None:
+            object.__setattr__(self, "depth", check_positive("depth", self.depth))
 
 
 @dataclass(frozen=True)

@@ -285,3 +285,32 @@ def test_swapping_mirrors_and_derivatives_are_the_normal(pair):
                 # truncation ~1e-11, round-off ~1e-9, far below a wrong normal (O(1)).
                 assert np.allclose(derivative, expected, atol=1e-7)
     assert checked >= 20  # most configurations touch: the test is not vacuous
+
+
+@pytest.mark.parametrize("face", [G.RECTANGLE, G.DISC], ids=["rectangle", "disc"])
+def test_a_face_with_a_depth_ignores_partners_behind_its_solid(face):
+    # Packed depth 0.5 (third parameter of a rectangle, second of a disc): a sphere 0.4 deep
+    # is in the solid (a contact), one 0.6 deep has passed behind it (none); without a depth
+    # (packed 0) the face bounds a half-space and both are contacts.
+    def face_params(depth):
+        return params(1.0, 0.5, depth) if face == G.RECTANGLE else params(1.0, depth)
+
+    for depth, expected in ((0.5, (1, 0)), (0.0, (1, 1))):
+        counts = []
+        for penetration in (0.4, 0.6):
+            gap = contacts(face, face_params(depth), np.zeros(3), IDENTITY, G.SPHERE,
+                           params(0.1), (0.2, 0.1, 0.1 - penetration), IDENTITY)[0]
+            counts.append(gap.shape[0])
+            if gap.shape[0]:
+                assert abs(gap[0] + penetration) < HAND
+        assert tuple(counts) == expected
+
+
+def test_face_depth_is_packed_and_validated():
+    from clearbench.scenarios.shapes import Disc, Rectangle
+    from clearbench.scenarios.validation import SceneError
+
+    assert G.pack_shape_parameters(Rectangle("r", half_extents=(1.0, 0.5), depth=0.25))[2] == 0.25
+    assert G.pack_shape_parameters(Disc("d", radius=1.0))[1] == 0.0  # no depth: unbounded
+    with pytest.raises((SceneError, ValueError), match="depth"):
+        Rectangle("r", half_extents=(1.0, 0.5), depth=-1.0)
