@@ -50,7 +50,7 @@ def register(subparsers) -> None:
 def run_validate(args: argparse.Namespace) -> int:
     from clearbench.adapters.reference import PRESETS
 
-    from .c60_validation import validate, write_figures, write_markdown
+    from .c60_validation import validate, write_figures, write_json, write_markdown
 
     if args.preset not in PRESETS:
         raise UserError(f"unknown preset {args.preset!r}; presets: {', '.join(PRESETS)}")
@@ -67,7 +67,8 @@ def run_validate(args: argparse.Namespace) -> int:
         print(f"- {finding}")
     figures = write_figures(report, args.figures)
     write_markdown(report, args.out, figures, args.preset)
-    print(f"report: {args.out}")
+    write_json(report, args.out.with_suffix(".json"), figures, args.preset)
+    print(f"report: {args.out} (and {args.out.with_suffix('.json')} for `clearbench report`)")
     for path in figures.values():
         print(f"figure: {path}")
     return 0

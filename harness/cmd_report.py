@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from .cli_common import add_store_option, open_store
-from .report import write_report
+from .report import C60_VALIDATION, write_report
 
 
 def register(subparsers) -> None:
@@ -19,12 +19,15 @@ def register(subparsers) -> None:
     add_store_option(parser)
     parser.add_argument("--out", default="reports/out", metavar="DIR",
                         help="output directory (default reports/out)")
+    parser.add_argument("--c60-validation", default=str(C60_VALIDATION), metavar="JSON",
+                        help="JSON of `clearbench c60 validate` to include as the C-60 section "
+                        f"(default {C60_VALIDATION}; left out when the file does not exist)")
     parser.set_defaults(handler=run_report)
 
 
 def run_report(args: argparse.Namespace) -> int:
     store = open_store(args, create=False)
-    paths = write_report(store, args.out)
+    paths = write_report(store, args.out, args.c60_validation)
     print(f"report: {paths['html']}")
     print(f"summary: {paths['markdown']}")
     return 0

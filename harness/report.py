@@ -4,8 +4,9 @@ Contents: an overview matrix (scene x engine: verdict and headline metric), the 
 extreme suite in the same form, per scene a table of every run with its metrics, the
 work–precision plot with its Pareto front and drift and creep over time, and per engine the
 features it approximates or does not support (from ``Engine.capabilities``, recorded with each
-run). Figures are embedded as base64 PNG in the HTML and written as PNG files beside the
-Markdown.
+run); when ``clearbench c60 validate`` has written its JSON, the C-60 table against the paper
+and its force-displacement figures. Figures are embedded as base64 PNG in the HTML and written
+as PNG files beside the Markdown.
 """
 
 from __future__ import annotations
@@ -55,6 +56,7 @@ class ReportData:
     approximations: dict                 # label -> {feature: (support, detail)}
     store: str
     generated: str
+    c60_validation: dict | None = None   # clearbench c60 validate's JSON (see load_c60_validation)
 
 
 def _representative(rows, scene: Scene | None) -> dict:
@@ -268,6 +270,72 @@ def _engines_html(data: ReportData) -> str:
             f"does not support, as the engine states it (Engine.capabilities):</p>{table}")
 
 
+def load_c60_validation(path: str | Path | None) -> dict | None:
+    """The JSON written by ``clearbench c60 validate`` (table, findings, runs, figures), with
+    the figures read in as PNG bytes under ``"figure_png"``; None when ``path`` is None or
+    does not exist (the C-60 section is then left out)."""
+    if path is None or not Path(path).is_file():
+        return None
+    document = json.loads(Path(path).read_text())
+    base = Path(path).parent
+    document["figure_png"] = {}
+    for title, relative in document.get("figures", {}).items():
+        figure = base / relative
+        if figure.is_file():
+            document["figure_png"][title] = figure.read_bytes()
+        else:
+            LOG.warning("C-60 validation figure %s is missing", figure)
+    return document
+
+
+def _c60_number(value, digits: int = 3) -> str:
+    return "-" if value is None else f"{value:.{digits}f}"
+
+
+def _c60_difference(value) -> str:
+    return "-" if value is None else f"{100 * value:+.1f} %"
+
+
+def _c60_html(validation: dict) -> str:
+    rows = "".join(
+        f"<tr><td>{_esc(r['quantity'])}{_esc(' (' + r['note'] + ')') if r['note'] else ''}"
+        f"</td><td>{_esc(r['unit'])}</td><td>{_c60_number(r['ours'])}</td>"
+        f"<td>{_c60_number(r['paper_simulated'])}</td><td>{_c60_number(r['paper_measured'])}"
+        f"</td><td>{_c60_difference(r['difference'])}</td></tr>" for r in validation["rows"])
+    findings = "".join(f"<li>{_esc(f)}</li>" for f in validation.get("findings", []))
+    figures = "".join(
+        f"<figure><img alt='{_esc(title)}' src='data:image/png;base64,"
+        f"{base64.b64encode(png).decode()}'><figcaption>{_esc(title)}</figcaption></figure>"
+        for title, png in validation.get("figure_png", {}).items())
+    return (f"<h2>{_esc(validation['title'])}</h2>"
+            f"<p class='small'>From <code>{_esc(validation['source'])}</code> (reference "
+            f"engine, preset {_esc(validation['preset'])}); paper: {_esc(validation['paper'])}."
+            " Differences are relative to the measured value where there is one, else to the "
+            "paper's simulated value; nothing is tuned to them.</p>"
+            "<table><tr><th>quantity</th><th>unit</th><th>ours</th><th>paper, simulated</th>"
+            f"<th>paper, measured</th><th>difference</th></tr>{rows}</table>"
+            f"<ul class='small'>{findings}</ul>{figures}")
+
+
+def _c60_markdown(validation: dict, figure_files: dict) -> list[str]:
+    lines = [f"## {validation['title']}", "",
+             f"From `{validation['source']}` (reference engine, preset {validation['preset']});"
+             f" paper: {validation['paper']}.", "",
+             "| quantity | unit | ours | paper, simulated | paper, measured | difference |",
+             "|---|---|---|---|---|---|"]
+    for r in validation["rows"]:
+        note = f" ({r['note']})" if r["note"] else ""
+        lines.append(f"| {_md_escape(r['quantity'] + note)} | {r['unit']} | "
+                     f"{_c60_number(r['ours'])} | {_c60_number(r['paper_simulated'])} | "
+                     f"{_c60_number(r['paper_measured'])} | "
+                     f"{_c60_difference(r['difference'])} |")
+    lines.append("")
+    lines += [f"- {_md_escape(f)}" for f in validation.get("findings", [])]
+    for title, path in figure_files.items():
+        lines += ["", f"![{title}]({path})"]
+    return lines + [""]
+
+
 def render_html(data: ReportData) -> str:
     frame = data.frame
     machines = ", ".join(sorted({f"{h} ({c}, {n} cores)" for h, c, n in
@@ -286,6 +354,7 @@ def render_html(data: ReportData) -> str:
         _overview_html(data, stiff=False),
         _overview_html(data, stiff=True),
         *(_section_html(s) for s in data.sections),
+        _c60_html(data.c60_validation) if data.c60_validation else "",
         _engines_html(data),
     ]
     return ("<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
@@ -299,7 +368,8 @@ def _md_escape(text) -> str:
     return str(text).replace("|", "\\|").replace("\n", " ")
 
 
-def render_markdown(data: ReportData, figure_files: dict) -> str:
+def render_markdown(data: ReportData, figure_files: dict, c60_figure_files: dict | None = None
+                    ) -> str:
     lines = ["# clearbench comparison report", "",
              f"Generated {data.generated} from `{data.store}`: {len(data.frame)} runs. "
              "Full report with figures: `report.html`.", ""]
@@ -333,6 +403,8 @@ def render_markdown(data: ReportData, figure_files: dict) -> str:
         for title, path in figure_files.get(section.name, {}).items():
             lines += ["", f"![{title}]({path})"]
         lines.append("")
+    if data.c60_validation:
+        lines += _c60_markdown(data.c60_validation, c60_figure_files or {})
     notes = _engine_notes(data)
     if notes:
         lines += ["## Engine approximations", "", "| engine | feature | support | how |",
@@ -342,11 +414,26 @@ def render_markdown(data: ReportData, figure_files: dict) -> str:
     return "\n".join(lines)
 
 
-def write_report(store: ResultsStore, out_dir: str | Path) -> dict[str, Path]:
-    """Write ``report.html``, ``summary.md`` and ``figures/*.png`` into ``out_dir``."""
+#: Where ``clearbench c60 validate`` writes its JSON (committed with the repository).
+C60_VALIDATION = Path("reports/c60_validation.json")
+
+
+def write_report(store: ResultsStore, out_dir: str | Path,
+                 c60_validation: str | Path | None = C60_VALIDATION) -> dict[str, Path]:
+    """Write ``report.html``, ``summary.md`` and ``figures/*.png`` into ``out_dir``.
+
+    ``c60_validation``: the JSON of ``clearbench c60 validate``; when it exists the report has
+    a section with the C-60 table against the paper and its force-displacement figures."""
     out = Path(out_dir)
     (out / "figures").mkdir(parents=True, exist_ok=True)
     data = collect(store)
+    data.c60_validation = load_c60_validation(c60_validation)
+    c60_figure_files: dict[str, str] = {}
+    if data.c60_validation:
+        for index, (title, png) in enumerate(data.c60_validation["figure_png"].items()):
+            name = f"figures/c60-validation-{index}.png"
+            (out / name).write_bytes(png)
+            c60_figure_files[title] = name
     figure_files: dict[str, dict[str, str]] = {}
     for section in data.sections:
         for index, (title, png) in enumerate(section.figures.items()):
@@ -356,5 +443,5 @@ def write_report(store: ResultsStore, out_dir: str | Path) -> dict[str, Path]:
     html_path = out / "report.html"
     md_path = out / "summary.md"
     html_path.write_text(render_html(data), encoding="utf-8")
-    md_path.write_text(render_markdown(data, figure_files), encoding="utf-8")
+    md_path.write_text(render_markdown(data, figure_files, c60_figure_files), encoding="utf-8")
     return {"html": html_path, "markdown": md_path}

@@ -20,7 +20,9 @@ from __future__ import annotations
 
 import enum
 import functools
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 import numpy as np
 import scipy.sparse as sp
@@ -74,6 +76,8 @@ def _dense_to_csr(W):
         indptr[i + 1] = k
     return data, indices, indptr
 LOCAL_SOLVERS = ("ac", "fb", "projection")
+
+_Derived = TypeVar("_Derived")
 
 
 def _as_matrix(W) -> np.ndarray | sp.csr_matrix:
@@ -170,6 +174,26 @@ class ContactProblem:
         """u = W r + q, shape (m,)."""
         return self.W @ r + self.q
 
+    @functools.cached_property
+    def _derived(self) -> dict:
+        return {}
+
+    def derived(self, key: str, compute: Callable[[ContactProblem], _Derived]) -> _Derived:
+        """``compute(self)``, evaluated once per problem and ``key`` (a solver's per-problem data).
+
+        For data that depends only on the problem (e.g. the inverse of the bilateral block of
+        W), so that several solves of one problem (the stepper's hybrid strategy tries NSGS,
+        then Newton from several starts) share it. The problem's arrays must not be modified.
+        """
+        cache = self._derived
+        if key not in cache:
+            cache[key] = compute(self)
+        return cache[key]
+
+    def forget_derived(self) -> None:
+        """Drop everything :meth:`derived` cached (benchmarks time a solve from scratch)."""
+        self.__dict__.pop("_derived", None)
+
 
 @dataclass(frozen=True)
 class SolverOptions:
@@ -226,8 +250,13 @@ class SolverOptions:
         if self.local_max_iterations < 1 or self.residual_check_interval < 1:
             raise ValueError("local_max_iterations and residual_check_interval must be >= 1")
 
+    @functools.cached_property
+    def use_max_normalisation(self) -> bool:
+        """True for the "max" normalisation, False for "q" (computed once per options)."""
+        return Normalisation(self.normalisation) is Normalisation.MAX
 
-@dataclass(frozen=True, eq=False)
+
+@dataclass(frozen=True, eq=False, init=False)
 class SolverResult:
     """Outcome of a contact solve.
 
@@ -268,3 +297,25 @@ class SolverResult:
     message: str = ""
     local_failures: int = 0
     history: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    def __init__(
+        self, r: np.ndarray, u: np.ndarray, iterations: int, residual: float, residual_q: float,
+        residual_max: float, converged: bool, status: SolverStatus, method: str,
+        message: str = "", local_failures: int = 0, history: np.ndarray | None = None,
+    ) -> None:
+        # Hand-written: the generated frozen __init__ sets each of the 12 fields through
+        # object.__setattr__ (about 2 us), more than a whole NSGS solve of one contact. The
+        # instance stays frozen (assignment raises FrozenInstanceError).
+        fields = self.__dict__
+        fields["r"] = r
+        fields["u"] = u
+        fields["iterations"] = iterations
+        fields["residual"] = residual
+        fields["residual_q"] = residual_q
+        fields["residual_max"] = residual_max
+        fields["converged"] = converged
+        fields["status"] = status
+        fields["method"] = method
+        fields["message"] = message
+        fields["local_failures"] = local_failures
+        fields["history"] = np.zeros(0) if history is None else history

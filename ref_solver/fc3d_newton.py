@@ -24,13 +24,12 @@ from numba import njit
 
 from .contact_problem import (
     ContactProblem,
-    Normalisation,
     SolverOptions,
     SolverResult,
     SolverStatus,
 )
 from .fc3d_local import LOCAL_KIND, alart_curnier
-from .fc3d_nsgs import bilateral_solve_operator, diagonal_blocks, nsgs_kernel
+from .fc3d_nsgs import bilateral_operator_of, diagonal_blocks, nsgs_kernel
 from .fc3d_residual import residual_both
 
 logger = logging.getLogger(__name__)
@@ -81,6 +80,32 @@ def dense_jacobian(W: np.ndarray, n_bilateral: int, rho_b: np.ndarray, A: np.nda
             for c in range(3):
                 J[k + a, k + c] += A[i, a, c]
             J[k + a, k + a] += delta
+
+
+@njit(cache=True)
+def _contact_scalings(blocks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """rho_N = 1 / W_ii[N, N], rho_T = 1 / max(W_ii[T1, T1], W_ii[T2, T2]) per contact, (nc,)
+    each (1 where the diagonal entry is not positive; rho_T falls back to rho_N)."""
+    nc = blocks.shape[0]
+    rho_n = np.ones(nc)
+    rho_t = np.ones(nc)
+    for i in range(nc):
+        w_nn = blocks[i, 0, 0]
+        w_tt = max(blocks[i, 1, 1], blocks[i, 2, 2])
+        if w_nn > 0.0:
+            rho_n[i] = 1.0 / w_nn
+        rho_t[i] = 1.0 / w_tt if w_tt > 0.0 else rho_n[i]
+    return rho_n, rho_t
+
+
+@njit(cache=True)
+def _bilateral_scalings(w_bb: np.ndarray) -> np.ndarray:
+    """rho_b = 1 / W_bb (1 where not positive), (nb,)."""
+    rho_b = np.ones(w_bb.size)
+    for b in range(w_bb.size):
+        if w_bb[b] > 0.0:
+            rho_b[b] = 1.0 / w_bb[b]
+    return rho_b
 
 
 def _block_diagonal(n_bilateral: int, bilateral_diagonal: np.ndarray, blocks: np.ndarray):
@@ -137,14 +162,9 @@ def solve_newton(
     """Semismooth Newton solve of ``problem``; see ``solve_contact_problem``."""
     W = problem.W_csr()
     q, mu, nb, nc, m = problem.q, problem.mu, problem.n_bilateral, problem.n_contacts, problem.size
-    use_max = Normalisation(options.normalisation) is Normalisation.MAX
-    blocks = diagonal_blocks(W, nb, nc)
-    w_nn = blocks[:, 0, 0]
-    w_tt = np.maximum(blocks[:, 1, 1], blocks[:, 2, 2])
-    rho_n = np.where(w_nn > 0.0, 1.0 / np.where(w_nn > 0.0, w_nn, 1.0), 1.0)
-    rho_t = np.where(w_tt > 0.0, 1.0 / np.where(w_tt > 0.0, w_tt, 1.0), rho_n)
-    w_bb = W.diagonal()[:nb]
-    rho_b = np.where(w_bb > 0.0, 1.0 / np.where(w_bb > 0.0, w_bb, 1.0), 1.0)
+    use_max = options.use_max_normalisation
+    rho_n, rho_t = _contact_scalings(diagonal_blocks(W, nb, nc))
+    rho_b = _bilateral_scalings(W.diagonal()[:nb]) if nb else np.zeros(0)
     r = np.zeros(m) if r0 is None else np.array(r0, dtype=np.float64, copy=True)
     if r.shape != (m,):
         raise ValueError(f"r0 must have shape ({m},), got {r.shape}")
@@ -154,7 +174,6 @@ def solve_newton(
     phi_try = np.zeros(m)
     A_try = np.zeros((nc, 3, 3))
     B_try = np.zeros((nc, 3, 3))
-    bilateral_operator = None
     W_dense = problem.W_dense() if m <= _DENSE_LIMIT else None
     J_dense = np.empty((m, m)) if W_dense is not None else None
     history: list[float] = []
@@ -169,12 +188,14 @@ def solve_newton(
     # Python overhead per call, more than the arithmetic of a small problem).
     W_product = W_dense if W_dense is not None else W
 
-    def measure(r_: np.ndarray) -> tuple[np.ndarray, float]:
-        u_ = W_product @ r_ + q
+    def measure(r_: np.ndarray, u_: np.ndarray | None = None):
+        """(u = W r + q unless given, |F|/|q|, |F|/max, the tested one of the two)."""
+        if u_ is None:
+            u_ = W_product @ r_ + q
         _, rel_q, rel_max = residual_both(r_, u_, q, mu, nb)
-        return u_, (rel_max if use_max else rel_q)
+        return u_, rel_q, rel_max, (rel_max if use_max else rel_q)
 
-    u, residual = measure(r)
+    u, residual_q, residual_max, residual = measure(r)
     while True:
         if residual <= options.tolerance:
             status = SolverStatus.CONVERGED
@@ -207,8 +228,10 @@ def solve_newton(
                     step_ok = True
                     break
                 step *= 0.5
+        u_next = None
         if step_ok:
             r = r_try
+            u_next = u_try  # = W r + q, the same expression measure() evaluates
         else:
             # rescue: a few NSGS sweeps from the current iterate
             rescues += 1
@@ -216,24 +239,18 @@ def solve_newton(
                 status = SolverStatus.STALLED
                 message = f"no descent direction after {rescues} NSGS rescues"
                 break
-            if bilateral_operator is None:
-                bilateral_operator = bilateral_solve_operator(problem.W_dense()[:nb, :nb])
             u_tmp = np.empty(m)
-            nsgs_kernel(W.indptr.astype(np.int64), W.indices.astype(np.int64), W.data, q, mu,
-                        nb, blocks, bilateral_operator, r, u_tmp, LOCAL_KIND["ac"],
-                        options.tolerance, use_max, _RESCUE_SWEEPS, options.local_tolerance,
-                        options.local_max_iterations, _RESCUE_SWEEPS,
+            nsgs_kernel(W.indptr, W.indices, W.data, q, mu, nb, bilateral_operator_of(problem),
+                        r, u_tmp, LOCAL_KIND["ac"], options.tolerance, use_max, _RESCUE_SWEEPS,
+                        options.local_tolerance, options.local_max_iterations, _RESCUE_SWEEPS,
                         np.full(_RESCUE_SWEEPS, np.nan))
-        u, residual = measure(r)
+        u, residual_q, residual_max, residual = measure(r, u_next)
         best_residual = min(best_residual, residual)
         history.append(residual)
     if status is SolverStatus.MAX_ITERATIONS:
         message = (f"{options.max_iterations} Newton iterations done, residual {residual:.3g}"
                    f" > {options.tolerance:.3g}")
-    u = W_product @ r + q
-    _, residual_q, residual_max = residual_both(r, u, q, mu, nb)
-    if status is not SolverStatus.NUMERICAL_FAILURE:
-        residual = residual_max if use_max else residual_q
+    # r, u and both residuals are those of the last measure() (every exit follows one)
     return SolverResult(
         r=r, u=u, iterations=int(iteration), residual=float(residual),
         residual_q=float(residual_q), residual_max=float(residual_max),

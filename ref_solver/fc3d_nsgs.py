@@ -19,7 +19,6 @@ from numba import njit
 
 from .contact_problem import (
     ContactProblem,
-    Normalisation,
     SolverOptions,
     SolverResult,
     SolverStatus,
@@ -36,6 +35,7 @@ _STATUS_CODES = (
     SolverStatus.NUMERICAL_FAILURE,
 )
 _NO_OPERATOR = np.zeros((0, 0))
+_METHOD_NAMES = {name: f"nsgs-{name}" for name in LOCAL_KIND}
 
 
 def diagonal_blocks(W_csr: sp.csr_matrix, n_bilateral: int, n_contacts: int) -> np.ndarray:
@@ -71,21 +71,40 @@ def bilateral_solve_operator(W_dense_bb: np.ndarray) -> np.ndarray:
     return np.linalg.pinv(W_dense_bb, rcond=1e-12)
 
 
+def bilateral_operator_of(problem: ContactProblem) -> np.ndarray:
+    """The (nb, nb) operator of :func:`bilateral_solve_operator` for ``problem``, computed once
+    per problem (shared by every solve of it); a (0, 0) array without bilateral rows."""
+    return problem.derived("bilateral_solve_operator", _compute_bilateral_operator)
+
+
+def _compute_bilateral_operator(problem: ContactProblem) -> np.ndarray:
+    nb = problem.n_bilateral
+    if nb == 0:
+        return _NO_OPERATOR
+    W = problem.W
+    block = W[:nb, :nb].toarray() if sp.issparse(W) else W[:nb, :nb]
+    return bilateral_solve_operator(block)
+
+
 @njit(cache=True)
 def nsgs_kernel(
     indptr: np.ndarray, indices: np.ndarray, data: np.ndarray, q: np.ndarray, mu: np.ndarray,
-    n_bilateral: int, blocks: np.ndarray, bilateral_operator: np.ndarray, r: np.ndarray,
-    u: np.ndarray, kind: int, tolerance: float, use_max: bool, max_sweeps: int,
-    local_tolerance: float, local_max_iterations: int, check_interval: int,
-    history: np.ndarray,
-) -> tuple[int, int, float, float, float, float, int, int]:
+    n_bilateral: int, bilateral_operator: np.ndarray, r: np.ndarray, u: np.ndarray, kind: int,
+    tolerance: float, use_max: bool, max_sweeps: int, local_tolerance: float,
+    local_max_iterations: int, check_interval: int, history: np.ndarray,
+) -> tuple[int, int, float, float, int, int]:
     """Run NSGS sweeps on r (in place); u receives W r + q at the last residual check.
 
-    The last sweep is always checked. Returns (status code: 0 converged / 1 max iterations /
-    3 non-finite, sweeps done, |F|, |q|, |r|, |u|, local failures in the last sweep, number of
-    checks). ``history`` (>= max_sweeps,) receives the normalised residual of each check.
+    W is given by its CSR arrays (indptr (m + 1,), indices, data); its (3, 3) diagonal contact
+    blocks are extracted here (one pass over the contact rows). The last sweep is always
+    checked. Returns (status code: 0 converged / 1 max iterations / 3 non-finite, sweeps done,
+    |F| / |q|, |F| / max(|q|, |r|, |u|) (NaN when non-finite), local failures in the last sweep,
+    number of checks). ``history`` (>= max_sweeps,) receives the residual in the tested
+    normalisation (``use_max``) of each check.
     """
     nc = mu.size
+    blocks = np.zeros((nc, 3, 3))
+    _extract_blocks(indptr, indices, data, n_bilateral, blocks)
     vec = np.zeros((N_VEC, 3))
     mat = np.zeros((N_MAT, 3, 3))
     ql = np.zeros(3)
@@ -136,52 +155,62 @@ def nsgs_kernel(
             norm_r = math.sqrt(np.dot(r, r))
             norm_u = math.sqrt(np.dot(u, u))
             if not math.isfinite(abs_residual + norm_r + norm_u):
-                return 3, sweep + 1, np.nan, norm_q, norm_r, norm_u, failures, n_checks
+                return 3, sweep + 1, np.nan, np.nan, failures, n_checks
             residual = normalised(abs_residual, norm_q, norm_r, norm_u, use_max)
             history[n_checks] = residual
             n_checks += 1
             if residual <= tolerance:
-                return 0, sweep + 1, abs_residual, norm_q, norm_r, norm_u, failures, n_checks
-    return 1, max_sweeps, abs_residual, norm_q, norm_r, norm_u, failures, n_checks
+                return (0, sweep + 1, normalised(abs_residual, norm_q, norm_r, norm_u, False),
+                        normalised(abs_residual, norm_q, norm_r, norm_u, True), failures,
+                        n_checks)
+    return (1, max_sweeps, normalised(abs_residual, norm_q, norm_r, norm_u, False),
+            normalised(abs_residual, norm_q, norm_r, norm_u, True), failures, n_checks)
 
 
 def solve_nsgs(
     problem: ContactProblem, options: SolverOptions, r0: np.ndarray | None = None
 ) -> SolverResult:
-    """NSGS solve of ``problem``; see :func:`clearbench.ref_solver.solve_contact_problem`."""
+    """NSGS solve of ``problem``; see :func:`clearbench.ref_solver.solve_contact_problem`.
+
+    The Python work around the compiled kernel is kept to a few microseconds (one kernel call,
+    the bilateral operator cached on the problem), since the reference stepper solves many
+    problems of a few contacts.
+    """
+    m = problem.q.size
+    if r0 is None:
+        r = np.zeros(m)
+    else:
+        r = np.array(r0, dtype=np.float64, copy=True)
+        if r.shape != (m,):
+            raise ValueError(f"r0 must have shape ({m},), got {r.shape}")
+    method = _METHOD_NAMES[options.local_solver]
+    if m == 0:
+        return SolverResult(r, r.copy(), 0, 0.0, 0.0, 0.0, True, SolverStatus.CONVERGED, method)
     W = problem.W_csr()
-    nb, nc = problem.n_bilateral, problem.n_contacts
-    blocks = diagonal_blocks(W, nb, nc)
-    operator = bilateral_solve_operator(problem.W_dense()[:nb, :nb]) if nb else _NO_OPERATOR
-    r = np.zeros(problem.size) if r0 is None else np.array(r0, dtype=np.float64, copy=True)
-    if r.shape != (problem.size,):
-        raise ValueError(f"r0 must have shape ({problem.size},), got {r.shape}")
-    if problem.size == 0:
-        return SolverResult(r=r, u=r.copy(), iterations=0, residual=0.0, residual_q=0.0,
-                            residual_max=0.0, converged=True, status=SolverStatus.CONVERGED,
-                            method=f"nsgs-{options.local_solver}")
-    u = np.empty(problem.size)
+    u = np.empty(m)
     history = np.empty(options.max_iterations)  # untouched pages cost nothing
-    use_max = Normalisation(options.normalisation) is Normalisation.MAX
-    code, sweeps, abs_residual, norm_q, norm_r, norm_u, failures, n_checks = nsgs_kernel(
-        W.indptr, W.indices, W.data, problem.q, problem.mu, nb, blocks, operator, r, u,
-        LOCAL_KIND[options.local_solver], options.tolerance, use_max, options.max_iterations,
-        options.local_tolerance, options.local_max_iterations, options.residual_check_interval,
-        history,
+    use_max = options.use_max_normalisation
+    nb = problem.n_bilateral
+    code, sweeps, residual_q, residual_max, failures, n_checks = nsgs_kernel(
+        W.indptr, W.indices, W.data, problem.q, problem.mu, nb,
+        bilateral_operator_of(problem) if nb else _NO_OPERATOR, r, u,
+        LOCAL_KIND[options.local_solver],
+        options.tolerance, use_max, options.max_iterations, options.local_tolerance,
+        options.local_max_iterations, options.residual_check_interval, history,
     )
+    if code == 0:
+        return SolverResult(r, u, sweeps, residual_max if use_max else residual_q, residual_q,
+                            residual_max, True, SolverStatus.CONVERGED, method, "", failures,
+                            history[:n_checks].copy())
     status = _STATUS_CODES[code]
-    residual_q = normalised(abs_residual, norm_q, norm_r, norm_u, False)
-    residual_max = normalised(abs_residual, norm_q, norm_r, norm_u, True)
-    message = ""
     if status is SolverStatus.MAX_ITERATIONS:
         message = f"{sweeps} sweeps done, residual {history[n_checks - 1]:.3g} > " \
                   f"{options.tolerance:.3g}"
-    elif status is SolverStatus.NUMERICAL_FAILURE:
+    else:
         message = f"non-finite residual after {sweeps} sweeps"
     return SolverResult(
-        r=r, u=u, iterations=int(sweeps), residual=residual_max if use_max else residual_q,
-        residual_q=residual_q, residual_max=residual_max,
-        converged=status is SolverStatus.CONVERGED, status=status,
-        method=f"nsgs-{options.local_solver}", message=message, local_failures=int(failures),
+        r=r, u=u, iterations=sweeps, residual=residual_max if use_max else residual_q,
+        residual_q=residual_q, residual_max=residual_max, converged=False, status=status,
+        method=method, message=message, local_failures=failures,
         history=history[:n_checks].copy(),
     )

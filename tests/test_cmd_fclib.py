@@ -14,7 +14,8 @@ def test_fclib_command_writes_table_csv_and_profile(tmp_path, capsys):
     profile = tmp_path / "profile.png"
     status = main(["fclib", str(DATA / "OneObject-i1028-138.hdf5.dat"),
                    str(DATA / "Chute-ndof-768-nc-4-3.hdf5"), "--solver", "nsgs-ac",
-                   "--solver", "newton-ac", "--repeat", "1", "--no-siconos", "--out", str(out),
+                   "--solver", "newton-ac", "--repeat", "1", "--min-time", "0", "--no-siconos",
+                   "--out", str(out),
                    "--profile", str(profile)])
     text = capsys.readouterr().out
     assert status == 0
@@ -22,6 +23,7 @@ def test_fclib_command_writes_table_csv_and_profile(tmp_path, capsys):
     rows = list(csv.DictReader(out.open()))
     assert [row["solver"] for row in rows] == ["nsgs-ac", "newton-ac"]
     assert all(row["solved"] == "True" for row in rows)
+    assert all(row["solves"] == "1" for row in rows)  # --repeat 1 and no minimum time
     assert profile.stat().st_size > 1000
 
 

@@ -1,5 +1,7 @@
 """NSGS and Newton on whole problems: statuses, warm start, sparse input, non-symmetric W; MLCP."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -12,6 +14,7 @@ from clearbench.ref_solver import (
     solve_contact_problem,
     solve_mlcp,
 )
+from clearbench.ref_solver.fc3d_nsgs import bilateral_operator_of
 
 
 def _random_problem(seed, nc=20, n_bilateral=0, asymmetry=0.0):
@@ -80,6 +83,30 @@ def test_warm_start_from_a_solution_needs_one_sweep():
     again = solve_contact_problem(problem, options, r0=first.r)
     assert first.iterations > 1
     assert again.converged and again.iterations == 1
+
+
+def test_bilateral_operator_is_computed_once_per_problem():
+    problem = _random_problem(7, nc=5, n_bilateral=3)
+    operator = bilateral_operator_of(problem)
+    for method in ("nsgs", "newton"):
+        assert solve_contact_problem(problem, SolverOptions(method=method)).converged
+    assert bilateral_operator_of(problem) is operator  # shared by every solve of the problem
+    problem.forget_derived()
+    recomputed = bilateral_operator_of(problem)
+    assert recomputed is not operator
+    np.testing.assert_array_equal(recomputed, operator)  # same computation: bitwise equal
+    # W_bb >= 0.2 I (well conditioned): the operator is its inverse to round-off
+    np.testing.assert_allclose(operator @ problem.W[:3, :3], np.eye(3), atol=1e-10)
+
+
+def test_solver_result_stays_frozen_and_replaceable():
+    result = solve_contact_problem(_random_problem(8, nc=3), SolverOptions())
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        result.iterations = 0
+    changed = dataclasses.replace(result, iterations=99)
+    assert changed.iterations == 99 and changed.status is result.status
+    # residual checked every sweep by default: one history entry per sweep
+    assert changed.history is result.history and result.history.size == result.iterations
 
 
 def test_sparse_and_dense_W_give_the_same_answer():

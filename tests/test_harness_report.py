@@ -132,3 +132,35 @@ def test_time_series_figure_from_a_fake_run(small_store):
     scene = small_store.scene(row["scene_hash"])
     png = time_series_figure(scene, {"fake": small_store.load_trajectory(row["key"])})
     assert png is not None and png.startswith(PNG_SIGNATURE)
+
+
+def test_report_has_the_c60_section_when_the_validation_json_exists(small_store, tmp_path):
+    import math
+
+    from clearbench.harness.c60_validation import Row, ValidationReport, write_json
+
+    figure = tmp_path / "reports" / "figures" / "c60_trip_force.png"
+    figure.parent.mkdir(parents=True)
+    figure.write_bytes(PNG_SIGNATURE + b"figure")  # stands for the PNG c60 validate draws
+    report = ValidationReport(rows=[
+        Row("Trip test: peak force", "N", 1.5, 1.87, 1.77),
+        Row("c60-trip: contacts open", "ms", 7.6, note="no published figure")],
+        findings=["a finding"])
+    validation = tmp_path / "reports" / "c60_validation.json"
+    write_json(report, validation, {"Trip force vs displacement": figure}, "default")
+    # The relative difference -15.3 % = (1.5 - 1.77) / 1.77 (measured value preferred);
+    # a missing paper figure is shown as "-", never as NaN.
+    assert math.isclose(report.rows[0].difference(), (1.5 - 1.77) / 1.77)
+    paths = write_report(small_store, tmp_path / "out", c60_validation=validation)
+    page = paths["html"].read_text()
+    summary = paths["markdown"].read_text()
+    assert "C-60: the reference engine against the published figures" in page
+    section = page[page.index("C-60: the reference"):page.index("Engines and their")]
+    assert "-15.3 %" in section and "nan" not in section.lower()
+    assert page.count("data:image/png;base64,") >= 1 and "Trip force vs displacement" in page
+    assert "| Trip test: peak force | N | 1.500 | 1.870 | 1.770 | -15.3 % |" in summary
+    assert (tmp_path / "out" / "figures" / "c60-validation-0.png").read_bytes() == \
+        figure.read_bytes()
+    # Without the file the section is left out.
+    plain = write_report(small_store, tmp_path / "plain", c60_validation=tmp_path / "none.json")
+    assert "C-60: the reference" not in plain["html"].read_text()
