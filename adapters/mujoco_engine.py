@@ -36,7 +36,12 @@ from clearbench.scenarios.units import SI
 from clearbench.scenarios.validation import TIME, VELOCITY
 
 from .base import Capability, Engine, RunSettings
-from .mujoco_capabilities import clearance_summary, mujoco_capabilities, ring_summary
+from .mujoco_capabilities import (
+    bore_summary,
+    clearance_summary,
+    mujoco_capabilities,
+    ring_summary,
+)
 from .mujoco_run import Runner
 from .mujoco_settings import OPTION_NAMES, PRESETS, MujocoSettings, resolve_settings
 from .trajectory import RunStatus, Trajectory
@@ -149,6 +154,7 @@ def _metadata(scene: Scene, internal: Scene, config: MujocoSettings, built, runn
         "contact_solref": [list(p.solref) for p in built.contact_parameters],
         "contact_dampratio": [p.damping_ratio for p in built.contact_parameters],
         "rings": ring_summary(scene, config),
+        "bores": bore_summary(scene, config),
         "clearance_joints": clearance_summary(scene, config),
         "tree": [[link.body, link.parent, link.kind, link.joint]
                  for link in built.topology.links],
