@@ -136,7 +136,19 @@ class ReferenceEngine(Engine):
         taken = 0
         for k in range(1, steps + 1):
             tick = time.perf_counter()
-            result = stepper.step(state)
+            try:
+                result = stepper.step(state)
+            except (ArithmeticError, ValueError, np.linalg.LinAlgError) as error:
+                # A failure inside a kernel is an outcome of the run: the state the step
+                # started from is kept as the last sample, to reproduce it.
+                stepping += time.perf_counter() - tick
+                if next_record < len(record):
+                    recorder.store(next_record, state, None)
+                    next_record += 1
+                status = RunStatus.CRASHED
+                message = (f"{type(error).__name__} in step {k} (from t = {state.t:.9g}; the "
+                           f"last sample is that step's start): {error}")
+                break
             stepping += time.perf_counter() - tick
             state = result.state
             taken = k

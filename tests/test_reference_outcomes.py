@@ -1,0 +1,34 @@
+"""A failure inside the reference engine's step is a recorded outcome, not a crash of the caller."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from clearbench.adapters.base import RunSettings
+from clearbench.adapters.reference import create
+from clearbench.adapters.trajectory import RunStatus
+from clearbench.ref_solver import stepper
+from clearbench.scenarios.registry import get_scene
+
+
+def test_an_exception_in_a_step_is_a_crashed_run_with_the_state_it_started_from(monkeypatch):
+    scene = get_scene("bouncing-ball-e0.5")
+    clean = create().run(scene, RunSettings(horizon=5 * scene.time_step))
+    original = stepper.MoreauJeanStepper.step
+    calls = {"n": 0}
+
+    def failing_step(self, state):
+        calls["n"] += 1
+        if calls["n"] == 5:  # the warm-up step, then steps 1, 2, 3: step 4 fails
+            raise ZeroDivisionError("division by zero")
+        return original(self, state)
+
+    monkeypatch.setattr(stepper.MoreauJeanStepper, "step", failing_step)
+    trajectory = create().run(scene, RunSettings(horizon=10 * scene.time_step))
+    assert trajectory.status is RunStatus.CRASHED
+    assert "ZeroDivisionError in step 4" in trajectory.message
+    # Samples 0..3 and the start of step 4 (= the end of step 3, repeated): the failing step
+    # can be replayed from the last sample. The steps before it are those of a clean run.
+    assert trajectory.steps == 3
+    np.testing.assert_array_equal(trajectory.positions[:4], clean.positions[:4])
+    np.testing.assert_array_equal(trajectory.positions[-1], clean.positions[3])
