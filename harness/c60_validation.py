@@ -253,6 +253,10 @@ def validate(cache: Path | None = None, preset: str = "default", speed_check: bo
             f"{slow_contact.loaded_travel:.4f} mm: "
             + ("the same curve within" if same else "NOT the same curve within")
             + " the stated tolerance.")
+    for key, run in report.runs.items():
+        if run.trajectory.status.value != "ok":
+            report.findings.append(f"Run {key} ({run.scene.name}) ended "
+                                   f"{run.trajectory.status.value}: {run.trajectory.message}")
     return report
 
 
@@ -391,13 +395,15 @@ def write_markdown(report: ValidationReport, path: Path, figures: dict[str, Path
         lines += ["", "## Differences above 10 %", ""]
         lines += [f"- {row.quantity}: {100 * row.difference():+.1f} %." for row in large]
     lines += ["", "## Runs", "",
-              "| run | scene | steps | stepping [s] | unconverged steps | max penetration [mm] |",
-              "|---|---|---|---|---|---|"]
+              "| run | scene | status | steps | stepping [s] | unconverged steps | "
+              "max penetration [mm] |",
+              "|---|---|---|---|---|---|---|"]
     for key, run in report.runs.items():
         unconverged = run.unconverged
         listed = ", ".join(str(k) for k in unconverged[:5]) + (" ..." if len(unconverged) > 5
                                                               else "")
-        lines.append(f"| {key} | {run.scene.name} | {run.trajectory.steps} | "
+        lines.append(f"| {key} | {run.scene.name} | {run.trajectory.status.value} | "
+                     f"{run.trajectory.steps} | "
                      f"{run.trajectory.stepping_seconds:.0f} | {len(unconverged)}"
                      f"{' (' + listed + ')' if unconverged else ''} | {run.penetration:.2e} |")
     if figures:
@@ -436,6 +442,7 @@ def write_json(report: ValidationReport, path: Path, figures: dict[str, Path],
         "findings": list(report.findings),
         "runs": [{"key": key, "scene": run.scene.name, "steps": run.trajectory.steps,
                   "stepping_seconds": run.trajectory.stepping_seconds,
+                  "status": run.trajectory.status.value, "message": run.trajectory.message,
                   "unconverged_steps": len(run.unconverged),
                   "unconverged_projections": len(
                       run.trajectory.metadata.get("unconverged_projections", [])),
