@@ -365,11 +365,49 @@ MODEL_NOTES = (
     "the handle turns freely (the source has no OFF stop) and brings its ON-stop face round "
     "behind the case's stop pins; without a depth that counted as an 8.5 mm penetration at "
     "15.2 ms and the projection tore the handle out of its bearing.",
+    "Angle laws take each body's absolute angle about the law's axis in (-pi, pi] (the source's "
+    "2 acos(q_w) in [0, 2 pi] likewise): a body turning through the cut makes the law's "
+    "moment jump by k 2 pi. In the contact-force test of this revision the mechanism does not "
+    "stay latched: the tripping bar turns freely from about 15 ms, the hook flips at about "
+    "25 ms, the plate passes the cut of the contact-pressure law between 28 and 29 ms, and the "
+    "run diverges before the probe touches (listed in the findings). Not yet analysed.",
     "Bounded faces: TRIP_1 and C3 ON 1, 2 have their nearest point beyond the face (no "
     "contact candidate; OpenCASCADE measures to the face's edge, 0.86 and 3.8 mm in the ON "
     "pose). Every other ON-pose gap agrees with OpenCASCADE within the CAD's B-spline residual "
     "(1.2e-4 mm).",
 )
+
+
+#: What we believe causes a difference above 10 % from the paper, by the start of the row's
+#: quantity. A belief, stated as such: none of these has been confirmed by a run that removes the
+#: cause.
+DIFFERENCE_CAUSES = (
+    ("FC-1", "the source's contact-pressure law, M = 244.46 (D + 0.49) N mm, balances at C7 "
+     "with about 7.4 N at the levers of the assembled CAD (the moment balance is in the "
+     "findings); about 15 N needs M near 300 N mm, so the paper's model had a stiffer or more "
+     "preloaded contact spring than this version of the source. The contact spring preload is "
+     "the one parameter the source comments as uncertain (0.49, 0.6547 or 0.9599 rad)."),
+    ("FC-", "one run at the nominal clearances compared with the mean of the paper's Monte "
+     "Carlo over manufacturing tolerances, and measurement pairs whose names pair oddly with "
+     "the paper's FC definitions (see the functional conditions above): the x distances agree "
+     "within 1.2 %, the y distances do not, which points at the pairs' y reference, not at "
+     "the dynamics."),
+    ("Trip test: peak force", "the force needed to pull the tripping-bar pin is set by the "
+     "latch load (C4, C5) times its friction, and the latch load by the handle and contact "
+     "springs; with the source's handle-spring arm (21 mm from the pivot instead of the law's "
+     "design arm, see the model notes) and its contact law (FC-1 above is half the paper's), "
+     "the latch of this model is loaded differently from the paper's. The displacement at the "
+     "peak and the trip distance, which depend on the latch geometry rather than on its load, "
+     "agree within 9 %."),
+)
+
+
+def difference_cause(quantity: str) -> str:
+    """What we believe causes the difference of the row ``quantity`` (see DIFFERENCE_CAUSES)."""
+    for prefix, cause in DIFFERENCE_CAUSES:
+        if quantity.startswith(prefix):
+            return cause
+    return "not analysed."
 
 
 def _fmt(value: float, digits: int = 3) -> str:
@@ -413,7 +451,8 @@ def write_markdown(report: ValidationReport, path: Path, figures: dict[str, Path
              and abs(row.difference()) > EXPLAIN_ABOVE and "sensitivity" not in row.note]
     if large:
         lines += ["", "## Differences above 10 %", ""]
-        lines += [f"- {row.quantity}: {100 * row.difference():+.1f} %." for row in large]
+        lines += [f"- {row.quantity}: {100 * row.difference():+.1f} %. What we believe causes "
+                  f"it: {difference_cause(row.quantity)}" for row in large]
     lines += ["", "## Runs", "",
               "| run | scene | status | steps | stepping [s] | unconverged steps | "
               "max penetration [mm] |",
@@ -457,7 +496,9 @@ def write_json(report: ValidationReport, path: Path, figures: dict[str, Path],
         "rows": [{"quantity": row.quantity, "unit": row.unit, "ours": _number(row.ours),
                   "paper_simulated": _number(row.paper_simulated),
                   "paper_measured": _number(row.paper_measured),
-                  "difference": _number(row.difference()), "note": row.note}
+                  "difference": _number(row.difference()), "note": row.note,
+                  "believed_cause": difference_cause(row.quantity)
+                  if abs(_number(row.difference()) or 0.0) > EXPLAIN_ABOVE else None}
                  for row in report.rows],
         "findings": list(report.findings),
         "runs": [{"key": key, "scene": run.scene.name, "steps": run.trajectory.steps,

@@ -302,6 +302,9 @@ def _c60_html(validation: dict) -> str:
         f"</td><td>{_esc(r['unit'])}</td><td>{_c60_number(r['ours'])}</td>"
         f"<td>{_c60_number(r['paper_simulated'])}</td><td>{_c60_number(r['paper_measured'])}"
         f"</td><td>{_c60_difference(r['difference'])}</td></tr>" for r in validation["rows"])
+    causes = "".join(f"<li>{_esc(r['quantity'])}: {_c60_difference(r['difference'])}. What we "
+                     f"believe causes it: {_esc(r['believed_cause'])}</li>"
+                     for r in validation["rows"] if r.get("believed_cause"))
     findings = "".join(f"<li>{_esc(f)}</li>" for f in validation.get("findings", []))
     figures = "".join(
         f"<figure><img alt='{_esc(title)}' src='data:image/png;base64,"
@@ -314,7 +317,8 @@ def _c60_html(validation: dict) -> str:
             "paper's simulated value; nothing is tuned to them.</p>"
             "<table><tr><th>quantity</th><th>unit</th><th>ours</th><th>paper, simulated</th>"
             f"<th>paper, measured</th><th>difference</th></tr>{rows}</table>"
-            f"<ul class='small'>{findings}</ul>{figures}")
+            f"<h3>Differences above 10 %</h3><ul class='small'>{causes}</ul>"
+            f"<h3>Findings</h3><ul class='small'>{findings}</ul>{figures}")
 
 
 def _c60_markdown(validation: dict, figure_files: dict) -> list[str]:
@@ -330,6 +334,9 @@ def _c60_markdown(validation: dict, figure_files: dict) -> list[str]:
                      f"{_c60_number(r['paper_measured'])} | "
                      f"{_c60_difference(r['difference'])} |")
     lines.append("")
+    lines += [f"- {_md_escape(r['quantity'])}: {_c60_difference(r['difference'])}. What we "
+              f"believe causes it: {_md_escape(r['believed_cause'])}"
+              for r in validation["rows"] if r.get("believed_cause")]
     lines += [f"- {_md_escape(f)}" for f in validation.get("findings", [])]
     for title, path in figure_files.items():
         lines += ["", f"![{title}]({path})"]
