@@ -4,6 +4,7 @@ step against the exact bounce, and the settings and options that switch it."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -99,10 +100,13 @@ def test_without_localisation_the_step_is_not_split_and_off_by_order_v_h():
 
 def test_step_takes_its_size_as_an_argument():
     stepper, state, _ = _ball_stepper(0.5, True, 1e-3)
-    other, _, _ = _ball_stepper(0.5, True, 2e-3)
+    other = MoreauJeanStepper(stepper.system, replace(stepper.settings, time_step=2e-3))
     # A step of 2e-3 s asked of a stepper set up for 1e-3 s is the step of a stepper set up for
     # 2e-3 s, bit for bit: nothing of the stepper depends on h but the argument.
-    assert np.array_equal(stepper.step(state, 2e-3).state.x, other.step(state).state.x)
+    for _ in range(3):
+        expected = other.step(state).state
+        assert np.array_equal(stepper.step(state, 2e-3).state.x, expected.x)
+        state = expected
     with pytest.raises(ValueError):
         stepper.step(state, 0.0)
 
