@@ -18,6 +18,25 @@ One step of length h from state k (Section 2.4 of Akhadkar, Acary, Brogliato 201
 5. Activation stage: I <- I U {alpha : g_alpha(q_{k+1}) <= 0}; when I grew, the step is redone
    from state k (eq. 22). I starts as the contacts already closed at q_k (gap <= the activation
    margin); without projection it starts as Moreau's prediction g + (h/2) u_N <= 0.
+6. Impact localisation (``localise_impacts=True``, with the projection): the steps above apply
+   an impact over the whole step. A ball approaching at speed v that crosses the ground at the
+   fraction tau of the step ends it (position update with the mean of the pre- and post-impact
+   velocities) |v| h (1 + e) (tau - 1/2) above its physical height when tau > (1 - e) / 2, or
+   projected onto the ground, e |v| h (1 - tau) below it, otherwise; and Newton's law acts on
+   the normal velocity at the start of the step instead of at the crossing, off by
+   g h (1 - (1 + e) tau). Both are O(h) (the position error is largest for tau near 0 or 1): a
+   relative apex error of order |v| h / apex. When the first activation round finds contacts
+   that were open at q_k and are closed at its end, approaching faster than the restitution
+   threshold with e > 0, the step is redone as (a) a substep of tau' h (tau: the crossing
+   fraction of the earliest of them, from :func:`crossing_fraction`; tau' = tau enlarged by a
+   relative 1e-9 and 4 ulps, at most 1) in which these contacts are not activated, so that the
+   motion is the free motion up to the crossing, (b) the impact at the crossing configuration as
+   a step of zero length (Moreau's scheme with h = 0: Newton's law and Coulomb friction on the
+   impulses, no position change, then the projection, which removes the penetration of order
+   1e-9 |v| h left by the enlargement when it exceeds the position tolerance), and (c) the rest
+   of the step, (1 - tau') h, from there (which may localise a later impact, up to
+   ``max_impact_splits`` per step). There is no cut-off near tau = 0 or 1: the classic position
+   error is largest there, and a substep of any length > 0 is a valid step.
 
 Every step returns :class:`StepStatistics`; a one-step problem that does not converge is
 flagged there, never hidden.
@@ -81,11 +100,19 @@ class StepperSettings:
         Impacts with a normal approach speed below this [L/T] are plastic (e = 0). A bounce of
         speed v under gravity g lasts 2 v / g; below about g h it fits within one step and a
         fixed-step scheme cannot resolve it: with e > 0 a resting body would chatter at an
-        amplitude of order e^2 g h^2 instead of coming to rest. 0 disables the threshold.
+        amplitude of order e^2 g h^2 instead of coming to rest. 0 disables the threshold. It is
+        a speed tied to the nominal step: the substeps of a localised impact keep it.
     joint_law : str
         ``midpoint``: ideal joints constrain the mid-step velocity (energy error O(h^2));
         ``end``: they constrain v_{k+1} as contacts do in Moreau–Jean (O(h) energy loss, the
         classic scheme; the limit of a clearance joint whose clearance goes to zero).
+    localise_impacts : bool
+        Split a step at the crossing time of a contact that closes within it with an elastic
+        impact (module docstring, item 6). Requires ``projection``. Off: the classic scheme,
+        whose apex error of a bouncing ball is first order in h.
+    max_impact_splits : int
+        Most impacts localised within one step (>= 1); later ones in the step are taken by the
+        classic scheme.
     """
 
     time_step: float
@@ -101,6 +128,8 @@ class StepperSettings:
     hybrid_sweeps: int = 100
     restitution_threshold: float = 0.0
     joint_law: str = "midpoint"
+    localise_impacts: bool = False
+    max_impact_splits: int = 1
 
     def __post_init__(self) -> None:
         if not self.time_step > 0.0:
@@ -111,6 +140,13 @@ class StepperSettings:
             raise ValueError(f"joint_law must be 'midpoint' or 'end', got {self.joint_law!r}")
         if not self.position_tolerance > 0.0:
             raise ValueError(f"position_tolerance must be > 0, got {self.position_tolerance!r}")
+        if not isinstance(self.localise_impacts, bool):
+            raise ValueError(f"localise_impacts must be a bool, got {self.localise_impacts!r}")
+        if self.localise_impacts and not self.projection:
+            raise ValueError("localise_impacts needs projection=True (it relies on the "
+                             "activation loop of the combined projection)")
+        if not self.max_impact_splits >= 1:
+            raise ValueError(f"max_impact_splits must be >= 1, got {self.max_impact_splits!r}")
 
 
 @dataclass(frozen=True)
@@ -120,6 +156,15 @@ class StepStatistics:
     ``solver_seconds`` is the wall time spent in the one-step contact solver and
     ``contact_sweeps`` the sum over its solves of (iterations x contacts), so that their ratio
     is the cost per contact per iteration.
+
+    A step with localised impacts (``StepperSettings.localise_impacts``) is computed in
+    ``substeps`` pieces (1 when it was not split; each localised impact adds the zero-length
+    impact and the rest of the step: 3 for one): the counts, seconds and sweeps are summed over
+    every piece, including the first activation round that found the crossing and was
+    abandoned (its work counts, its result is discarded, so its convergence does not);
+    ``solver_residual`` and ``projection_violation`` are the largest of the pieces, the
+    converged flags hold when every piece converged, ``active_contacts`` counts the contacts
+    active in any piece.
     """
 
     solver_iterations: int
@@ -133,6 +178,7 @@ class StepStatistics:
     gyroscopic_iterations: int
     solver_seconds: float = 0.0
     contact_sweeps: int = 0
+    substeps: int = 1
 
 
 @dataclass
@@ -142,6 +188,11 @@ class StepResult:
     ``contact_impulse`` (npair, K, 3) in each contact's frame (N, T1, T2) [F T];
     ``contact_frame`` (npair, K, 3, 3) rows n, t1, t2; ``contact_point`` (npair, K, 3) world
     point on shape B; ``contact_active`` (npair, K) bool.
+
+    Of a step computed in substeps (localised impacts): the impulses of the substeps summed in
+    world coordinates and expressed in the frame of the last substep in which the contact was
+    active (frames and points of that substep), ``contact_active`` true when the contact was
+    active in any substep.
     """
 
     state: State
@@ -243,11 +294,90 @@ class MoreauJeanStepper:
         self.cluster_start = np.array(start, dtype=np.int64)
 
     # ------------------------------------------------------------------ one step
-    def step(self, state: State) -> StepResult:
-        """Advance ``state`` by one time step (``state`` is not modified)."""
+    def step(self, state: State, time_step: float | None = None) -> StepResult:
+        """Advance ``state`` by ``time_step`` [T] (default ``settings.time_step``); ``state`` is
+        not modified. Nothing of the stepper depends on the step size but this argument."""
+        h = self.settings.time_step if time_step is None else float(time_step)
+        if not h > 0.0:
+            raise ValueError(f"time_step must be > 0, got {time_step!r}")
+        splits = self.settings.max_impact_splits if self.settings.localise_impacts else 0
+        return self._advance(state, h, splits)
+
+    def _advance(self, state: State, h: float, splits: int) -> StepResult:
+        """One step of length h, localising at most ``splits`` impacts (module docstring)."""
+        attempt = self._single_step(state, h, watch=splits > 0)
+        if isinstance(attempt, StepResult):
+            return attempt
+        crossing: _Crossing = attempt
+        fraction = min(crossing.fraction * (1.0 + 1e-9) + 4.0 * np.finfo(float).eps, 1.0)
+        h1 = fraction * h
+        parts = [crossing.abandoned]
+        # (a) Free motion to the crossing: the crossing contacts are not activated.
+        flight = self._single_step(state, h1, suppress=crossing.contacts)
+        parts.append(flight.statistics)
+        pieces = [flight]
+        current = flight.state
+        # (b) The impact at the crossing configuration, a step of zero length; skipped when the
+        # estimate left every crossing contact open (the rest of the step then takes it).
+        cand = self._candidates(current.x, rotation_matrices(current.p))
+        if (self._slots(cand, cand[0] <= self.settings.activation_margin)
+                & crossing.contacts).any():
+            impact = self._single_step(current, 0.0)
+            parts.append(impact.statistics)
+            pieces.append(impact)
+            current = impact.state
+        # (c) The rest of the step.
+        if fraction < 1.0:
+            rest = self._advance(current, h - h1, splits - 1)
+            parts.append(rest.statistics)
+            pieces.append(rest)
+            current = rest.state
+        current.t = state.t + h  # the time of the unsplit step, to the last bit
+        return self._combine(current, parts, pieces)
+
+    @staticmethod
+    def _combine(state: State, parts: list[StepStatistics], pieces: list[StepResult]
+                 ) -> StepResult:
+        """One :class:`StepResult` from the substeps of a split step (see its docstring)."""
+        active = np.zeros_like(pieces[0].contact_active)
+        world = np.zeros_like(pieces[0].contact_impulse)
+        frame = pieces[-1].contact_frame.copy()
+        point = pieces[-1].contact_point.copy()
+        for piece in pieces:
+            on = piece.contact_active
+            world[on] += np.einsum("ki,kij->kj", piece.contact_impulse[on],
+                                   piece.contact_frame[on])
+            frame[on] = piece.contact_frame[on]
+            point[on] = piece.contact_point[on]
+            active |= on
+        impulse = np.einsum("pkij,pkj->pki", frame, world)
+        stats = StepStatistics(
+            solver_iterations=sum(p.solver_iterations for p in parts),
+            solver_residual=max(p.solver_residual for p in parts),
+            solver_converged=all(p.solver_converged for p in parts),
+            active_contacts=int(active.sum()),
+            activation_rounds=sum(p.activation_rounds for p in parts),
+            projection_iterations=sum(p.projection_iterations for p in parts),
+            projection_violation=max(p.projection_violation for p in parts),
+            projection_converged=all(p.projection_converged for p in parts),
+            gyroscopic_iterations=sum(p.gyroscopic_iterations for p in parts),
+            solver_seconds=sum(p.solver_seconds for p in parts),
+            contact_sweeps=sum(p.contact_sweeps for p in parts),
+            substeps=sum(p.substeps for p in parts),
+        )
+        return StepResult(state, stats, impulse, frame, point, active)
+
+    def _single_step(self, state: State, h: float, suppress: np.ndarray | None = None,
+                     watch: bool = False) -> StepResult | _Crossing:
+        """Steps 1-5 of the module docstring over a step of length h >= 0 [T].
+
+        ``suppress`` (npair, K) bool: contacts the activation loop must not add. ``watch``: when
+        the first activation round closes contacts that call for localisation, return a
+        :class:`_Crossing` instead of finishing the step.
+        """
         sys_ = self.system
         cfg = self.settings
-        h, theta = cfg.time_step, cfg.theta
+        theta = cfg.theta
         rotation = rotation_matrices(state.p)
         nu = np.concatenate((state.v, state.omega), axis=1)  # (nb, 6)
 
@@ -288,7 +418,7 @@ class MoreauJeanStepper:
         while True:
             rounds += 1
             new_state, impulses, solve, closed = self._velocity_stage(
-                state, rotation, nu, free, inverse, cand, active)
+                state, h, rotation, nu, free, inverse, cand, active)
             projection = (0, 0.0, True)
             if cfg.projection:
                 projection = self._projection_stage(new_state, active, impulses, closed)
@@ -299,6 +429,23 @@ class MoreauJeanStepper:
             rotation_new = rotation_matrices(new_state.p)
             cand_new = self._candidates(new_state.x, rotation_new)
             closing = self._slots(cand_new, cand_new[0] <= 0.0) & ~active
+            if suppress is not None:
+                closing &= ~suppress
+            if watch and rounds == 1 and closing.any():
+                crossing = self._crossing(state, h, rotation, nu, cand, cand_new, closing)
+                if crossing is not None:
+                    # Work done and discarded: it counts in the cost, not in the
+                    # convergence of the step.
+                    abandoned = StepStatistics(
+                        solver_iterations=totals["iterations"], solver_residual=0.0,
+                        solver_converged=True, active_contacts=0,
+                        activation_rounds=rounds,
+                        projection_iterations=totals["projection_iterations"],
+                        projection_violation=0.0, projection_converged=True,
+                        gyroscopic_iterations=int(gyro_iterations),
+                        solver_seconds=self._solver_seconds,
+                        contact_sweeps=self._contact_sweeps, substeps=0)
+                    return _Crossing(crossing[0], crossing[1], abandoned)
             if not closing.any() or rounds >= cfg.max_activation_rounds:
                 break
             active = active | closing
@@ -313,6 +460,33 @@ class MoreauJeanStepper:
             solver_seconds=self._solver_seconds, contact_sweeps=self._contact_sweeps,
         )
         return StepResult(new_state, stats, impulses, cand[3], cand[2], active)
+
+    def _crossing(self, state, h, rotation, nu, cand, cand_end, closing):
+        """Contacts that call for localisation among ``closing`` (open at q_k, closed at the
+        end of the first activation round): approaching faster than the restitution threshold
+        with e > 0. Returns (crossing fraction of the earliest, (npair, K) mask of them), or
+        None when there is none."""
+        sys_ = self.system
+        pairs, slots = np.nonzero(closing & (sys_.pair_restitution[:, None] > 0.0))
+        if not len(pairs):
+            return None
+        # The candidate slot must be there and open at q_k (a new candidate has no start gap).
+        start = cand[0][pairs, slots]
+        known = np.isfinite(start) & (start > 0.0)
+        pairs, slots = pairs[known], slots[known]
+        if not len(pairs):
+            return None
+        u_start = self._normal_velocity(state, rotation, cand, nu)[pairs, slots]
+        fast = u_start < -self.settings.restitution_threshold
+        pairs, slots, u_start = pairs[fast], slots[fast], u_start[fast]
+        if not len(pairs):
+            return None
+        fractions = [crossing_fraction(float(cand[0][p, s]), float(u * h),
+                                       float(cand_end[0][p, s]))
+                     for p, s, u in zip(pairs, slots, u_start, strict=True)]
+        mask = np.zeros_like(closing)
+        mask[pairs, slots] = True
+        return min(fractions), mask
 
     # ------------------------------------------------------------------ pieces
     def _solve(self, problem: ContactProblem, r0: np.ndarray):
@@ -437,10 +611,10 @@ class MoreauJeanStepper:
         out[rows[4], rows[5]] = values[0::3]
         return out
 
-    def _velocity_stage(self, state, rotation, nu, free, inverse, cand, active):
+    def _velocity_stage(self, state, h, rotation, nu, free, inverse, cand, active):
         sys_ = self.system
         cfg = self.settings
-        h, theta = cfg.time_step, cfg.theta
+        theta = cfg.theta
         t1 = state.t + h
         # Joint Jacobians at the predicted configuration q_k + theta h v_k: with theta = 1/2
         # this makes ideal joints second order in energy (at q_k the energy error is O(h)).
@@ -598,6 +772,52 @@ class MoreauJeanStepper:
                 return iteration + 1, worst, False
             row_body, row_coef, values, n_equal, worst = trial
         return cfg.max_projection_iterations, worst, False
+
+
+def crossing_fraction(gap_start: float, gap_rate: float, gap_end: float) -> float:
+    """Fraction s in (0, 1] of a step at which a contact's gap reaches zero.
+
+    The gap over the step is taken as the quadratic g(s) = g0 + b s + c s^2 through the gap at
+    the start g0 > 0 [L], its rate b = h u_N,k [L] (normal velocity times the step) and the
+    gap at the end of the step's free motion g1 <= 0 [L]: exact for ballistic flight (constant
+    acceleration), where the theta = 1/2 position update is exact. Returns the root in (0, 1]
+    (there is exactly one, since g(0) > 0 >= g(1)).
+    """
+    g0, b, g1 = gap_start, gap_rate, gap_end
+    if not (g0 > 0.0 and g1 <= 0.0):
+        raise ValueError(f"need gap_start > 0 >= gap_end, got {g0!r}, {g1!r}")
+    c = g1 - g0 - b
+    roots = []
+    if c == 0.0:
+        if b != 0.0:
+            roots.append(-g0 / b)
+    else:
+        root = np.sqrt(max(b * b - 4.0 * c * g0, 0.0))
+        q = -0.5 * (b + np.copysign(root, b))
+        roots.append(q / c)
+        if q != 0.0:
+            roots.append(g0 / q)
+    inside = [r for r in roots if 0.0 < r <= 1.0]
+    if inside:
+        return float(min(inside))
+    # Round-off put the root just outside (0, 1]: bisect the quadratic.
+    low, high = 0.0, 1.0
+    for _ in range(80):
+        middle = 0.5 * (low + high)
+        if g0 + middle * (b + c * middle) > 0.0:
+            low = middle
+        else:
+            high = middle
+    return high
+
+
+@dataclass(frozen=True)
+class _Crossing:
+    """First activation round of a step that calls for impact localisation."""
+
+    fraction: float               # crossing fraction of the earliest crossing contact
+    contacts: np.ndarray          # (npair, K) bool: the contacts crossing within the step
+    abandoned: StepStatistics     # the work done before the step was abandoned
 
 
 @dataclass(frozen=True)
