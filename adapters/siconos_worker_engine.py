@@ -347,9 +347,15 @@ def define_siconos_classes(sk):
 
         def computeMExt(self, time, m_ext=None):
             _, moment = self.loads.on_body(self.body, time)
-            target = self._mExt if m_ext is None else m_ext
-            for i in range(3):
-                target[i] = moment[i]
+            if m_ext is None:
+                # A fresh vector, not a write into ``self._mExt``: that SWIG member getter of
+                # Siconos 4.4 (Debian, Python 3.11) drops a reference to None at each access
+                # (about 1.6 per call with the write); None's count (~1e4) reached 0 after a
+                # few hundred steps of C-60 ("none_dealloc", abort).
+                self.setMExtPtr(np.array(moment, dtype=float))
+            else:
+                for i in range(3):
+                    m_ext[i] = moment[i]
 
     class DriverBC(sk.BoundaryCondition):
         """Prescribed twist components of a driven body, evaluated at the time Siconos asks

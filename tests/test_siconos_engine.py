@@ -216,6 +216,23 @@ def test_time_switched_moment_and_body_frame_force_match_the_reference():
 
 
 @requires_siconos
+def test_a_long_run_with_a_python_moment_does_not_exhaust_none():
+    """Writing the moment through ``self._mExt`` dropped a reference to None per access (a
+    SWIG getter of Siconos 4.4): the worker aborted ("none_dealloc") after ~2000 steps of a
+    body with a moment, and after a few hundred steps of C-60. 6000 steps must run."""
+    scene = Scene(
+        name="long-moment", gravity=(0.0, 0.0, 0.0), horizon=6.0, time_step=1e-3,
+        bodies=(Body("b", mass=1.0, inertia=diagonal(0.5, 0.5, 0.5)),),
+        loads=(Moment("m", body="b", moment=(0.0, 0.0, 0.25), frame="body"),))
+    trajectory = siconos_engine.create().run(scene)
+    assert trajectory.status is RunStatus.OK, trajectory.message
+    assert trajectory.steps == 6000
+    # A constant moment about a principal axis: omega_z = M t / I = 3 rad/s at t = 6 s, which
+    # Moreau-Jean integrates exactly; 1e-9 rad/s leaves room for the Newton tolerance only.
+    assert abs(trajectory.angular_velocities[-1, 0, 2] - 3.0) < 1e-9
+
+
+@requires_siconos
 def test_driven_slider_crank_follows_the_closed_form_kinematics():
     scene = get_scene("slider-crank")
     trajectory = siconos_engine.create("projection").run(scene)
