@@ -20,8 +20,9 @@ import numpy as np
 import pytest
 
 from clearbench.adapters import siconos_engine
-from clearbench.adapters.base import Support
+from clearbench.adapters.base import RunSettings, Support
 from clearbench.adapters.reference_build import build_system
+from clearbench.adapters.trajectory import RunStatus
 from clearbench.ref_solver.forces import applied_forces, rotation_matrices
 from clearbench.scenarios.loads import AngleLawLoad, DistanceLawLoad, LoadApplication
 from clearbench.scenarios.quaternion import quat_normalize, quat_to_matrix
@@ -161,3 +162,23 @@ def test_unknown_features_are_unsupported(monkeypatch):
         for feature, capability in siconos_engine.create().capabilities(
                 get_scene(name)).items():
             assert "does not know" not in capability.detail, (name, feature)
+
+
+def test_projection_refuses_pairs_that_drop_candidates():
+    """The combined projection pulls active contacts to y = 0 as equalities: a dropped slot
+    (gap 1e12) would be pulled back, so bounded faces and bores are unsupported with it, by
+    preset and by option; the default preset keeps them."""
+    scene = get_scene("c60-on")
+    capabilities = siconos_engine.create("projection").capabilities(scene)
+    for pair in ("pair:arc-bore", "pair:cylinder-rectangle"):
+        assert capabilities[pair].support is Support.UNSUPPORTED
+        assert "index set 2" in capabilities[pair].detail
+    # Pairs that never drop a candidate stay supported with projection.
+    assert capabilities["pair:circle-cylinder"].support is Support.NATIVE
+    trajectory = siconos_engine.create("projection").run(scene)
+    assert trajectory.status is RunStatus.UNSUPPORTED and "CombinedProjection" in trajectory.message
+    # Switched on by an option: refused before any worker starts.
+    trajectory = siconos_engine.create("nsn-ac").run(
+        scene, RunSettings(options={"projection": True}))
+    assert trajectory.status is RunStatus.UNSUPPORTED
+    assert "pair:arc-bore" in trajectory.message
