@@ -16,7 +16,8 @@ Presets (each a separate engine variant ``siconos[preset]`` in results):
   normalised residual; contacts activate when y + h/2 y' <= 1e-10 x the smallest feature.
 - ``projection``: the same with the combined projection scheme
   (``MoreauJeanCombinedProjectionOSI`` + ``TimeSteppingCombinedProjection``; enumerative MLCP
-  projection on the active set, tolerance 1e-8 x the scene's smallest feature length).
+  projection on the active set, tolerance 1e-8 x the scene's smallest feature length). It
+  refuses pairs that drop candidates (bounded faces, bores): see PROJECTION_DROPPED_SLOTS.
 - ``nsn-ac``: as ``default`` with the semismooth Newton (Alart-Curnier) fc3d solver (scenes
   with ideal joints still use ``GenericMechanical``, whose only solver is NSGS).
 

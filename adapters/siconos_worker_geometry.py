@@ -110,7 +110,8 @@ _E1 = (3.0 / math.sqrt(13.0), -2.0 / math.sqrt(13.0), 0.0)
 
 
 def candidate_count(kind_a, kind_b):
-    """Number of candidates of the pair (either order), or None if not supported here."""
+    """Number of candidate slots of the pair (either order; one Siconos interaction each), or
+    None if not supported here."""
     if (kind_a, kind_b) in CANONICAL_PAIRS:
         return CANONICAL_PAIRS[(kind_a, kind_b)]
     return CANONICAL_PAIRS.get((kind_b, kind_a))
