@@ -16,7 +16,8 @@ Presets (each a separate engine variant ``siconos[preset]`` in results):
   normalised residual; contacts activate when y + h/2 y' <= 1e-10 x the smallest feature.
 - ``projection``: the same with the combined projection scheme
   (``MoreauJeanCombinedProjectionOSI`` + ``TimeSteppingCombinedProjection``; enumerative MLCP
-  projection on the active set, tolerance 1e-8 x the scene's smallest feature length).
+  projection on the active set, tolerance 1e-8 x the scene's smallest feature length). It
+  refuses pairs that drop candidates (bounded faces, bores): see PROJECTION_DROPPED_SLOTS.
 - ``nsn-ac``: as ``default`` with the semismooth Newton (Alart-Curnier) fc3d solver (scenes
   with ideal joints still use ``GenericMechanical``, whose only solver is NSGS).
 
@@ -30,11 +31,12 @@ equality rows), ``contact_frame`` ("shared", or
 the normal when n_z dominates and n_x != n_y; kept to document that bug), ``timeout`` [s] of
 the worker process and ``fault`` (fault injection for tests: "segfault", "hang", "exception").
 
-Approximations, stated per feature by :meth:`SiconosEngine.capabilities`: springs are explicit
-forces (no stiffness Jacobian); rotation drivers prescribe the body-axis angular velocity
-aligned with the driven world axis at t = 0; position drivers are imposed through their rate.
+Approximations, stated per feature by :meth:`SiconosEngine.capabilities`: springs and law
+loads are explicit forces (no stiffness Jacobian); rotation drivers prescribe the body-axis
+angular velocity aligned with the driven world axis at t = 0; position drivers are imposed
+through their rate.
 Unsupported: box-box and capsule-capsule pairs (their candidate count changes with the
-configuration; see :mod:`siconos_worker_geometry`).
+configuration; see :mod:`siconos_worker_geometry`), and any feature the adapter does not know.
 """
 
 from __future__ import annotations
@@ -89,6 +91,54 @@ _JOINT_CLASSES = {"revolute": "PivotJointR", "spherical": "KneeJointR",
                   "prismatic": "PrismaticJointR", "fixed": "FixedJointR"}
 
 
+#: Features the worker handles exactly (within the nonsmooth time stepping), with how.
+_NATIVE_FEATURES = {
+    "gravity": "constant force in computeFExt",
+    "contacts": "one NewtonImpactFrictionNSL interaction per candidate, exact (nonsmooth)",
+    "friction": "Coulomb cone of NewtonImpactFrictionNSL, exact (nonsmooth)",
+    "restitution": "Newton impact law of NewtonImpactFrictionNSL",
+    "rings": "ring geometry of the shared kernels",
+    "arcs": "arc geometry of the shared kernels",
+    "clearance_joints": "expanded into their contact pairs (shared expansion)",
+    "closed_loop": "GenericMechanical with Gauss-Seidel over all blocks (redundant joint rows)",
+    "point_forces": "computeFExt / computeMExt at the step ends (theta-weighted)",
+    "moments": "computeMExt at the step ends (theta-weighted)",
+    "time_switched_loads": "switch tested at the times Moreau-Jean evaluates the loads (the "
+                           "step ends): resolved to one step",
+    "fixed_bodies": "no dynamical system (contacts with one dynamical system)",
+}
+#: Configuration-dependent forces applied explicitly, with what they are.
+_EXPLICIT_FORCES = {
+    "springs": "force",
+    "torsional_springs": "moment",
+    "angle_law_loads": "law scalar (scenarios.loads.AngleLawLoad) and its applications",
+    "distance_law_loads": "law scalar (scenarios.loads.DistanceLawLoad) and its applications",
+}
+
+
+#: Why the combined projection cannot take pairs that drop candidates.
+PROJECTION_DROPPED_SLOTS = (
+    "TimeSteppingCombinedProjection projects the active contacts with a positive reaction "
+    "(index set 2) as equalities (it iterates while |y| >= tolerance): a candidate dropped "
+    "(off a bounded face, outside a bore) while active is pulled back from its inactive gap; "
+    "c60-trip diverged at 2.15 ms, the hook and the tripping bar thrown 1e10 mm apart")
+
+
+def _pair_capability(kind_a: str, kind_b: str, projection: bool = False) -> Capability:
+    reason = siconos_worker_geometry.unsupported_reason(kind_a, kind_b)
+    if reason:
+        return Capability(Support.UNSUPPORTED, reason)
+    if projection and siconos_worker_geometry.drops_candidates(kind_a, kind_b):
+        return Capability(Support.UNSUPPORTED, PROJECTION_DROPPED_SLOTS)
+    detail = ("Python NewtonEuler3DR relation with the shared closed-form gap, points and "
+              "contact frame")
+    if siconos_worker_geometry.drops_candidates(kind_a, kind_b):
+        detail += ("; one interaction per candidate slot, a slot the face or bore drops is "
+                   f"handed the gap {siconos_worker_geometry.DROPPED_GAP:g} (inactive) until "
+                   "the candidate returns")
+    return Capability(Support.NATIVE, detail)
+
+
 @functools.cache
 def availability() -> tuple[bool, str]:
     """Whether Debian's interpreter imports the Siconos kernel and joints (never raises)."""
@@ -130,33 +180,42 @@ class SiconosEngine(Engine):
 
     # ------------------------------------------------------------------ capabilities
     def capabilities(self, scene: Scene) -> dict[str, Capability]:
+        """Support of every scene feature; a feature this adapter does not know is UNSUPPORTED
+        (it must never claim what it does not do)."""
         out = {}
         for feature in scene.features:
             if feature.startswith("pair:"):
                 a, b = feature[5:].split("-")
-                reason = siconos_worker_geometry.unsupported_reason(a, b)
-                out[feature] = Capability(Support.UNSUPPORTED, reason) if reason else \
-                    Capability(Support.NATIVE, "Python NewtonEuler3DR relation with the shared "
-                               "closed-form gap, points and contact frame")
+                out[feature] = _pair_capability(a, b, bool(PRESETS[self.preset]["projection"]))
+            elif feature.startswith("shape:"):
+                kind = feature[6:]
+                out[feature] = Capability(Support.NATIVE, "shared closed-form geometry") \
+                    if kind in siconos_worker_geometry.SHAPE_KINDS else \
+                    Capability(Support.UNSUPPORTED, f"no worker geometry for shape {kind!r}")
             elif feature.startswith("joint:"):
                 kind = feature[6:]
                 out[feature] = Capability(
                     Support.NATIVE, f"{_JOINT_CLASSES[kind]} + EqualityConditionNSL") \
                     if kind in _JOINT_CLASSES else \
                     Capability(Support.UNSUPPORTED, f"no Siconos joint for {kind!r}")
-            elif feature in ("springs", "torsional_springs"):
+            elif feature in _EXPLICIT_FORCES:
                 out[feature] = Capability(
-                    Support.APPROXIMATED, "force from the current iterate in computeFExt / "
-                    "computeMExt, theta-weighted by Moreau-Jean without a stiffness Jacobian: "
-                    "stable only for h < 2 / omega of the stiffest spring")
+                    Support.APPROXIMATED, _EXPLICIT_FORCES[feature] + " from the current "
+                    "iterate in computeFExt / computeMExt, theta-weighted by Moreau-Jean "
+                    "without a stiffness Jacobian: stable only for h < 2 / omega of the "
+                    "stiffest spring")
             elif feature == "drivers":
                 out[feature] = self._driver_capability(scene)
             elif feature == "ideal_joints":
                 out[feature] = Capability(
                     Support.NATIVE, "Siconos joint relations at velocity level; position drift "
                     "corrected only by the projection preset")
+            elif feature in _NATIVE_FEATURES:
+                out[feature] = Capability(Support.NATIVE, _NATIVE_FEATURES[feature])
             else:
-                out[feature] = Capability(Support.NATIVE, "exact (nonsmooth)")
+                out[feature] = Capability(
+                    Support.UNSUPPORTED, f"the Siconos adapter does not know feature "
+                    f"{feature!r}")
         return out
 
     @staticmethod
@@ -225,6 +284,14 @@ class SiconosEngine(Engine):
         options = self.resolved_options(scene, settings)
         h = settings.time_step or scene.time_step
         horizon = settings.horizon or scene.horizon
+        if options["projection"]:  # the preset may not have it, an option may switch it on
+            dropping = sorted(f for f in scene.features if f.startswith("pair:")
+                              and siconos_worker_geometry.drops_candidates(*f[5:].split("-")))
+            if dropping:
+                return Trajectory.empty(
+                    self.name, self.preset, scene, RunStatus.UNSUPPORTED,
+                    f"{', '.join(dropping)} with projection: {PROJECTION_DROPPED_SLOTS}", h,
+                    {"projection": True})
         worker_settings = {key: options[key] for key in options if key != "timeout"}
         worker_settings.update(time_step=h, horizon=horizon, record_every=settings.record_every)
         inputs = {"scene_json": np.array(scene_to_json(scene.expanded, indent=None)),

@@ -30,7 +30,13 @@ The model (kernel API, no io layer):
 - contacts: one ``Interaction`` (``NewtonImpactFrictionNSL``) per candidate point of each pair,
   whose relation is :class:`ContactRelation`, a Python subclass of ``NewtonEuler3DR`` computing h
   and the Jacobian from the shared geometry conventions (the built-in frame of Siconos 4.4 has a
-  first tangent that is not orthogonal to the normal when n_z dominates and n_x != n_y);
+  first tangent that is not orthogonal to the normal when n_z dominates and n_x != n_y); a pair
+  with a bounded face or a bore keeps one interaction per candidate SLOT, and a slot the
+  geometry drops (candidate off the face, deeper than its depth, outside the bore) gets the gap
+  ``siconos_worker_geometry.DROPPED_GAP``: its interaction is inactive until the candidate
+  comes back (then with whatever gap it has, as in the reference solver);
+- law loads (angle and distance laws) enter ``computeFExt`` / ``computeMExt`` like the springs,
+  evaluated at the current iterate;
 - integrator: ``MoreauJeanOSI`` (+ ``TimeStepping``) or ``MoreauJeanCombinedProjectionOSI`` (+
   ``TimeSteppingCombinedProjection`` with an ``MLCPProjectOnConstraints``); one-step problem
   ``FrictionContact`` (contacts only) or ``GenericMechanical`` (contacts and joints).
@@ -73,6 +79,11 @@ SETTINGS_KEYS = (
                             # "assemble", "mlcp"
     "fault",                # fault injection for tests: "", "segfault", "hang", "exception"
 )
+
+#: Load kinds the worker applies (``scenarios.loads``); any other kind is refused.
+LOAD_KINDS = ("point_force", "moment", "linear_spring", "torsional_spring", "angle_law",
+              "distance_law")
+_LAW_KINDS = ("angle_law", "distance_law")
 
 #: Twist index of each driver component (rotations: resolved to a body axis, see DriverBC).
 _TRANSLATION = {"x": 0, "y": 1, "z": 2}
@@ -179,6 +190,14 @@ def _packed_parameters(shape):
     if kind == "arc":
         return [shape.get("radius", 0.1), shape.get("start_angle", 0.0),
                 shape.get("end_angle", math.pi)]
+    # An absent face depth (None) is 0 in the packed form: no bound.
+    if kind == "rectangle":
+        return list(shape.get("half_extents", (0.5, 0.5))) + [shape.get("depth") or 0.0]
+    if kind == "disc":
+        return [shape.get("radius", 0.5), shape.get("depth") or 0.0]
+    if kind == "bore":
+        return [shape.get("radius", 0.1), shape.get("half_length", 0.5),
+                shape.get("start_angle", 0.0), shape.get("end_angle", 2.0 * math.pi)]
     raise ValueError(f"unknown shape kind {kind!r}")
 
 
@@ -204,6 +223,7 @@ class Pair:
         self.b_first = not self.body_b.fixed
         self._key = None
         self._value = None
+        self.dropped = 0  # dropped slots over all evaluated configurations (statistics)
         self._fixed_a = None
         self._fixed_b = None
 
@@ -213,9 +233,11 @@ class Pair:
         return q[:3] + rotation @ shape[2], rotation @ shape[3], rotation
 
     def evaluate(self, q_a, q_b):
-        """Candidates at the body states q_a, q_b (7,) each: (gap - offset (K,), point_a (K, 3),
-        point_b (K, 3), frame (K, 3, 3)). Cached on the last configuration; the placement of a
-        fixed body's shape is computed once."""
+        """Candidate slots at the body states q_a, q_b (7,) each: (gap - offset (K,), point_a
+        (K, 3), point_b (K, 3), frame (K, 3, 3)); a dropped slot (off a bounded face, outside a
+        bore) has the gap DROPPED_GAP and keeps the kernel's points and frame for its Jacobian.
+        Cached on the last configuration; the placement of a fixed body's shape is computed
+        once."""
         key = (q_a.tobytes(), q_b.tobytes())
         if key != self._key:
             if self._fixed_a is None or not self.body_a.fixed:
@@ -224,10 +246,12 @@ class Pair:
                 self._fixed_b = self._placement(self.shape_b, q_b)
             position_a, orientation_a, _ = self._fixed_a
             position_b, orientation_b, _ = self._fixed_b
-            gap, point_a, point_b, frame = geometry.pair_contacts(
+            gap, point_a, point_b, frame, kept = geometry.pair_contact_slots(
                 self.shape_a[0], self.shape_a[1], position_a, orientation_a,
                 self.shape_b[0], self.shape_b[1], position_b, orientation_b)
-            self._value = (gap - self.offset, point_a, point_b, frame)
+            gap = np.where(kept, gap - self.offset, geometry.DROPPED_GAP)
+            self.dropped += int(np.count_nonzero(~kept))
+            self._value = (gap, point_a, point_b, frame)
             self._key = key
         return self._value
 
@@ -323,9 +347,15 @@ def define_siconos_classes(sk):
 
         def computeMExt(self, time, m_ext=None):
             _, moment = self.loads.on_body(self.body, time)
-            target = self._mExt if m_ext is None else m_ext
-            for i in range(3):
-                target[i] = moment[i]
+            if m_ext is None:
+                # A fresh vector, not a write into ``self._mExt``: that SWIG member getter of
+                # Siconos 4.4 (Debian, Python 3.11) drops a reference to None at each access
+                # (about 1.6 per call with the write); None's count (~1e4) reached 0 after a
+                # few hundred steps of C-60 ("none_dealloc", abort).
+                self.setMExtPtr(np.array(moment, dtype=float))
+            else:
+                for i in range(3):
+                    m_ext[i] = moment[i]
 
     class DriverBC(sk.BoundaryCondition):
         """Prescribed twist components of a driven body, evaluated at the time Siconos asks
@@ -355,9 +385,19 @@ class Loads:
         self.loads = scene.get("loads", [])
         self.per_body = {name: [] for name in bodies}
         for load in self.loads:
-            for key in ("body", "body_a", "body_b"):
-                if key in load:
-                    self.per_body[load[key]].append(load)
+            kind = load["kind"]
+            if kind not in LOAD_KINDS:
+                raise ValueError(f"load {load.get('name')!r}: unknown load kind {kind!r}")
+            if kind in _LAW_KINDS:
+                # A law load acts only on the bodies of its applications.
+                targets = []
+                for application in load["applications"]:
+                    if application["body"] not in targets:
+                        targets.append(application["body"])
+            else:
+                targets = [load[key] for key in ("body", "body_a", "body_b") if key in load]
+            for target in targets:
+                self.per_body[target].append(load)
         self._unwrap = {}
         self.nonfinite = False  # set when a load evaluated to NaN / inf (a diverging run)
 
@@ -414,6 +454,15 @@ class Loads:
                 moment_world += np.cross(arm, f)
             elif kind == "torsional_spring":
                 moment_world += self._torsion(load, name)
+            else:  # angle_law, distance_law
+                scalar = self._law_scalar(load)
+                for application in load["applications"]:
+                    if application["body"] != name:
+                        continue
+                    f, m = _law_action(application, scalar, kind == "angle_law", rotation,
+                                       body.com)
+                    force = force + f
+                    moment_world += m
         moment = rotation.T @ moment_world
         if not (np.isfinite(force).all() and np.isfinite(moment).all()):
             # Siconos aborts (assert) on a NaN force: hand it zeros and let the step loop stop
@@ -421,6 +470,25 @@ class Loads:
             self.nonfinite = True
             return np.zeros(3), np.zeros(3)
         return force, moment
+
+    def _law_scalar(self, load):
+        """The scalar s of a law load: a moment [F L] (angle law) or a force [F] (distance
+        law), as ``scenarios.loads`` defines it (formulas of ``ref_solver.forces``)."""
+        if load["kind"] == "angle_law":
+            axis = [float(v) for v in load.get("axis", (0.0, 0.0, 1.0))]
+            total = float(load.get("offset", 0.0))
+            for body_name, coefficient in zip(load["angle_bodies"], load["angle_coefficients"],
+                                              strict=True):
+                q, _ = self.bodies[body_name].state()
+                total += float(coefficient) * twist_angle(geometry.quat_to_matrix(q[3:7]), axis)
+            return float(load.get("stiffness", 0.0)) * total
+        point_a, _, _, _ = self._point(self.bodies[load["body_a"]],
+                                       load.get("point_a", (0.0, 0.0, 0.0)))
+        point_b, _, _, _ = self._point(self.bodies[load["body_b"]],
+                                       load.get("point_b", (0.0, 0.0, 0.0)))
+        d = point_b - point_a
+        return float(load.get("stiffness", 0.0)) * (
+            float(load.get("rest_length", 0.0)) - math.sqrt(float(d @ d)))
 
     def _torsion(self, load, name):
         body_a = self.bodies[load["body_a"]]
@@ -445,6 +513,40 @@ class Loads:
         torque = -(load.get("preload", 0.0) + load.get("stiffness", 0.0) * (
             phi - load.get("rest_angle", 0.0)) + load.get("damping", 0.0) * rate)
         return torque * axis if name == load["body_b"] else -torque * axis
+
+
+def twist_angle(rotation, axis):
+    """Absolute rotation angle [rad] of a body about the unit world ``axis``, from its rotation
+    matrix (3, 3): 2 atan2(axis . vee(R - R^T), 1 + tr R) (``ref_solver.forces.twist_angle``:
+    2 atan2(q . axis, q_w) for the quaternion with q_w >= 0)."""
+    vee_x = rotation[2, 1] - rotation[1, 2]
+    vee_y = rotation[0, 2] - rotation[2, 0]
+    vee_z = rotation[1, 0] - rotation[0, 1]
+    trace = rotation[0, 0] + rotation[1, 1] + rotation[2, 2]
+    return 2.0 * math.atan2(axis[0] * vee_x + axis[1] * vee_y + axis[2] * vee_z, 1.0 + trace)
+
+
+def _law_action(application, scalar, scalar_is_moment, rotation, com):
+    """World force (3,) [F] and world moment about the centre of mass (3,) [F L] of one
+    application of a law load (``scenarios.loads.LoadApplication``) whose scalar is
+    ``scalar``, on a body of rotation (3, 3) and centre of mass ``com`` (body frame [L])."""
+    direction = np.array(application.get("direction", (1.0, 0.0, 0.0)), dtype=float)
+    direction = direction / math.sqrt(float(direction @ direction))
+    if application.get("frame", "body") == "body":
+        direction = rotation @ direction
+    coefficient = float(application.get("coefficient", 1.0))
+    lever = application.get("lever")
+    if lever is None:
+        gain = coefficient
+    elif scalar_is_moment:
+        gain = coefficient / float(lever)
+    else:
+        gain = coefficient * float(lever)
+    value = gain * scalar * direction
+    if application.get("action", "force") == "moment":
+        return np.zeros(3), value
+    arm = rotation @ (np.array(application.get("point", (0.0, 0.0, 0.0)), dtype=float) - com)
+    return value, np.cross(arm, value)
 
 
 def _conjugate(q):
@@ -704,6 +806,9 @@ class SiconosModel:
             "unconverged_count": len(unconverged),
             "python_relation_seconds": self.callback_seconds[0],
             "contact_interactions": sum(len(items) for items in self.contact_interactions),
+            # Candidate slots found dropped (off a bounded face, outside a bore), summed over
+            # the configurations the relations evaluated: each such slot was handed DROPPED_GAP.
+            "dropped_slot_evaluations": sum(pair.dropped for pair in self.pairs),
             "joint_interactions": len(self.joint_interactions),
         }
         if self.position_problem is not None:

@@ -31,10 +31,21 @@ capsule-sphere      1   closest point of the axis segment
 cylinder-sphere     1   closest point of the solid cylinder
 circle-cylinder     1   ring against the (infinitely long) lateral surface of a journal
 arc-cylinder        1   the same, restricted to the arc
+rectangle-X         as  plane-X for X = sphere (1), cylinder (8), circle (1), arc (1); a
+disc-X              ..  candidate whose point is off the face, or deeper than its depth, is
+                        dropped
+circle-bore         1   ring point farthest from the bore axis; dropped outside the bore's
+arc-bore            1   angles or beyond its length
+cylinder-bore       2   one per end of the axial overlap (slot 0 at the bore's -z side);
+                        dropped when there is no overlap or outside the bore's angles
 =================  ===  =======================================================================
 
-Box-box and capsule-capsule are not ported: their candidate count changes with the
-configuration (clipping, parallel axes), which a fixed set of Siconos interactions cannot follow.
+K is the number of SLOTS (one Siconos interaction each): :func:`pair_contact_slots` keeps every
+candidate in its slot and flags the dropped ones (the shared geometry compacts the kept ones,
+which :func:`pair_contacts` reproduces for the agreement tests).
+
+Box-box and capsule-capsule are not ported: their candidates come from clipping or from a
+parallel-axes test, with no fixed slot a Siconos interaction could follow.
 """
 
 import math
@@ -42,8 +53,11 @@ import math
 import numpy as np
 
 #: Shape kinds (the ``kind`` strings of the scene description).
-SPHERE, BOX, CAPSULE, CYLINDER, PLANE, CIRCLE, ARC = (
-    "sphere", "box", "capsule", "cylinder", "plane", "circle", "arc")
+SPHERE, BOX, CAPSULE, CYLINDER, PLANE, CIRCLE, ARC, RECTANGLE, DISC, BORE = (
+    "sphere", "box", "capsule", "cylinder", "plane", "circle", "arc", "rectangle", "disc",
+    "bore")
+#: Every shape kind the worker knows (packed parameters: see pair_contact_slots).
+SHAPE_KINDS = (SPHERE, BOX, CAPSULE, CYLINDER, PLANE, CIRCLE, ARC, RECTANGLE, DISC, BORE)
 
 #: Canonical pairs (kind on A, kind on B) -> number of candidates; reversed orders are mirrored.
 CANONICAL_PAIRS = {
@@ -59,7 +73,25 @@ CANONICAL_PAIRS = {
     (CYLINDER, SPHERE): 1,
     (CIRCLE, CYLINDER): 1,
     (ARC, CYLINDER): 1,
+    (RECTANGLE, SPHERE): 1,
+    (RECTANGLE, CYLINDER): 8,
+    (RECTANGLE, CIRCLE): 1,
+    (RECTANGLE, ARC): 1,
+    (DISC, SPHERE): 1,
+    (DISC, CYLINDER): 8,
+    (DISC, CIRCLE): 1,
+    (DISC, ARC): 1,
+    (CIRCLE, BORE): 1,
+    (ARC, BORE): 1,
+    (CYLINDER, BORE): 2,
 }
+#: Gap [L] the worker hands Siconos for a dropped slot (a candidate off a bounded face, deeper
+#: than its depth, outside a bore's angles or length): far beyond any activation threshold
+#: (y + h/2 y' <= ~1e-10 of the smallest feature), so the interaction stays inactive until the
+#: candidate comes back; finite, so Siconos's norms of the outputs stay finite.
+DROPPED_GAP = 1e12
+#: Shape kinds whose pairs can drop candidates (a bounded face, a bore).
+DROPPING_KINDS = (RECTANGLE, DISC, BORE)
 
 #: Why the pairs of the shared geometry that are not ported here are missing.
 NOT_PORTED = {
@@ -78,10 +110,16 @@ _E1 = (3.0 / math.sqrt(13.0), -2.0 / math.sqrt(13.0), 0.0)
 
 
 def candidate_count(kind_a, kind_b):
-    """Number of candidates of the pair (either order), or None if not supported here."""
+    """Number of candidate slots of the pair (either order; one Siconos interaction each), or
+    None if not supported here."""
     if (kind_a, kind_b) in CANONICAL_PAIRS:
         return CANONICAL_PAIRS[(kind_a, kind_b)]
     return CANONICAL_PAIRS.get((kind_b, kind_a))
+
+
+def drops_candidates(kind_a, kind_b):
+    """True if the pair (either order) can leave candidate slots empty."""
+    return kind_a in DROPPING_KINDS or kind_b in DROPPING_KINDS
 
 
 def unsupported_reason(kind_a, kind_b):
@@ -449,15 +487,17 @@ def _ring_critical_angles(a1, b1, a2, b2):
     return angles
 
 
-def _ring_angle(centre_offset, e1, e2, ring_radius, axis, start_angle, span, is_arc):
+def _ring_angle(centre_offset, e1, e2, ring_radius, axis, start_angle, span, is_arc, sign):
+    """Angle of the ring point nearest the axis (sign 1) or farthest from it (sign -1: a ring
+    inside a bore); every coefficient and distance comparison is multiplied by ``sign``."""
     s = _axpy(-_dot(centre_offset, axis), axis, centre_offset)
-    a1 = 2.0 * ring_radius * _dot(s, e1)
-    b1 = 2.0 * ring_radius * _dot(s, e2)
+    a1 = sign * 2.0 * ring_radius * _dot(s, e1)
+    b1 = sign * 2.0 * ring_radius * _dot(s, e2)
     beta1 = _dot(e1, axis)
     beta2 = _dot(e2, axis)
     rho_squared = ring_radius * ring_radius
-    a2 = -0.5 * rho_squared * (beta1 * beta1 - beta2 * beta2)
-    b2 = -rho_squared * beta1 * beta2
+    a2 = -sign * 0.5 * rho_squared * (beta1 * beta1 - beta2 * beta2)
+    b2 = -sign * rho_squared * beta1 * beta2
     r1 = math.hypot(a1, b1)
     r2 = math.hypot(a2, b2)
     if r1 == 0.0 and r2 == 0.0:
@@ -474,14 +514,14 @@ def _ring_angle(centre_offset, e1, e2, ring_radius, axis, start_angle, span, is_
             if is_arc and not _arc_angle_in_range(angle, start_angle, span):
                 continue
             distance, _ = _ring_axis_distance(angle, centre_offset, e1, e2, ring_radius, axis)
-            if distance < best_distance:
-                best_angle, best_distance = angle, distance
+            if sign * distance < best_distance:
+                best_angle, best_distance = angle, sign * distance
         if not is_arc:
             return best_angle
     for theta in (start_angle, start_angle + span):
         distance, _ = _ring_axis_distance(theta, centre_offset, e1, e2, ring_radius, axis)
-        if distance < best_distance:
-            best_angle, best_distance = theta, distance
+        if sign * distance < best_distance:
+            best_angle, best_distance = theta, sign * distance
     return best_angle
 
 
@@ -491,7 +531,8 @@ def _ring_cylinder(ring_position, ring_rotation, ring_radius, start_angle, span,
     e1 = _column(ring_rotation, 0)
     e2 = _column(ring_rotation, 1)
     centre_offset = _sub(ring_position, cylinder_position)
-    theta = _ring_angle(centre_offset, e1, e2, ring_radius, axis, start_angle, span, is_arc)
+    theta = _ring_angle(centre_offset, e1, e2, ring_radius, axis, start_angle, span, is_arc,
+                        1.0)
     distance, perpendicular = _ring_axis_distance(theta, centre_offset, e1, e2, ring_radius,
                                                   axis)
     inward = _scale(perpendicular, -1.0 / distance) if distance > 0.0 \
@@ -502,8 +543,128 @@ def _ring_cylinder(ring_position, ring_rotation, ring_radius, start_angle, span,
     return [(inward, ring_point, distance - cylinder_radius)]
 
 
+# ---------------------------------------------------------------------------- bounded faces
+def _keep_inside_face(plane_position, plane_rotation, half_x, half_y, radius, depth, staged):
+    """Per staged contact: True if its point on the face lies inside it (|x| <= half_x and
+    |y| <= half_y for a rectangle, radius < 0; x^2 + y^2 <= radius^2 for a disc) and its gap
+    is not below -depth (depth 0: no bound). The slots are kept in place (no compaction)."""
+    kept = []
+    for _, point, gap in staged:
+        if depth > 0.0 and gap < -depth:
+            kept.append(False)
+            continue
+        local = _to_local(plane_position, plane_rotation, point)
+        if radius >= 0.0:
+            inside = local[0] * local[0] + local[1] * local[1] <= radius * radius
+        else:
+            inside = abs(local[0]) <= half_x and abs(local[1]) <= half_y
+        kept.append(inside)
+    return kept
+
+
+# ---------------------------------------------------------------------------- bores
+def _bore_angle_in_range(bore_position, bore_rotation, point, start_angle, span):
+    local = _to_local(bore_position, bore_rotation, point)
+    if span >= _TWO_PI:
+        return True
+    return _arc_angle_in_range(math.atan2(local[1], local[0]), start_angle, span)
+
+
+def _ring_in_bore(ring_position, ring_rotation, ring_radius, start_angle, span, is_arc,
+                  bore_position, bore_rotation, bore_radius, bore_half_length, bore_start,
+                  bore_span, check_axial):
+    """Ring (A) inside the bore (B): (staged contact, kept). Not kept when the point on the
+    bore is outside the bore's angles (or, with ``check_axial``, beyond |z| > half_length)."""
+    axis = _column(bore_rotation, 2)
+    e1 = _column(ring_rotation, 0)
+    e2 = _column(ring_rotation, 1)
+    centre_offset = _sub(ring_position, bore_position)
+    theta = _ring_angle(centre_offset, e1, e2, ring_radius, axis, start_angle, span, is_arc,
+                        -1.0)
+    distance, perpendicular = _ring_axis_distance(theta, centre_offset, e1, e2, ring_radius,
+                                                  axis)
+    outward = _scale(perpendicular, 1.0 / distance) if distance > 0.0 \
+        else _any_perpendicular(axis)
+    c, s = math.cos(theta), math.sin(theta)
+    ring_point = _add(ring_position, _add(_scale(e1, ring_radius * c),
+                                          _scale(e2, ring_radius * s)))
+    gap = bore_radius - distance
+    staged = (outward, ring_point, gap)
+    on_bore = _axpy(gap, outward, ring_point)
+    if check_axial and abs(_dot(_sub(on_bore, bore_position), axis)) > bore_half_length:
+        return staged, False
+    if not _bore_angle_in_range(bore_position, bore_rotation, on_bore, bore_start, bore_span):
+        return staged, False
+    return staged, True
+
+
+def _cylinder_in_bore(journal_position, journal_rotation, journal_radius, journal_half_length,
+                      bore_position, bore_rotation, bore_radius, bore_half_length, bore_start,
+                      bore_span):
+    """Journal (A) inside the bore (B): two slots, one per end of the axial overlap (slot 0 at
+    the bore's -z side, slot 1 at its +z side); (staged contacts, kept flags)."""
+    axis_b = _column(bore_rotation, 2)
+    axis_j = _column(journal_rotation, 2)
+    direction = 1.0 if _dot(axis_j, axis_b) >= 0.0 else -1.0
+    centre = _dot(_sub(journal_position, bore_position), axis_b)
+    reach = journal_half_length * abs(_dot(axis_j, axis_b))
+    if centre - reach > bore_half_length or centre + reach < -bore_half_length:
+        # No axial overlap: two empty slots (a placeholder frame for their Jacobians).
+        placeholder = (_any_perpendicular(axis_b), journal_position, 0.0)
+        return [placeholder, placeholder], [False, False]
+    staged, kept = [], []
+    for end in (-1.0, 1.0):
+        if end * (centre + end * reach) > bore_half_length:
+            rim_position = _axpy(end * bore_half_length, axis_b, bore_position)
+            is_arc = bore_span < _TWO_PI
+            normal, rim_point, gap = _ring_cylinder(
+                rim_position, bore_rotation, bore_radius, bore_start, bore_span, is_arc,
+                journal_position, journal_rotation, journal_radius)[0]
+            normal = (-normal[0], -normal[1], -normal[2])
+            staged.append((normal, _axpy(-gap, normal, rim_point), gap))
+            kept.append(True)
+        else:
+            rim_position = _axpy(direction * end * journal_half_length, axis_j,
+                                 journal_position)
+            contact, inside = _ring_in_bore(
+                rim_position, journal_rotation, journal_radius, 0.0, _TWO_PI, False,
+                bore_position, bore_rotation, bore_radius, bore_half_length, bore_start,
+                bore_span, False)
+            staged.append(contact)
+            kept.append(inside)
+    return staged, kept
+
+
+# ---------------------------------------------------------------------------- dispatch
 def _canonical(kind_a, pa, pos_a, rot_a, kind_b, pb, pos_b, rot_b):
-    """Staged contacts of a canonical pair (inputs as tuples)."""
+    """Staged contacts of a canonical pair (inputs as tuples) and the kept flag of each slot."""
+    if kind_a in (RECTANGLE, DISC):
+        radius = pa[0] if kind_a == DISC else -1.0
+        depth = pa[1] if kind_a == DISC else pa[2]
+        if kind_b not in (SPHERE, CYLINDER, CIRCLE, ARC):
+            raise ValueError(f"unsupported pair {kind_a}-{kind_b}")
+        staged = _canonical(PLANE, (), pos_a, rot_a, kind_b, pb, pos_b, rot_b)[0]
+        return staged, _keep_inside_face(pos_a, rot_a, pa[0], pa[1], radius, depth, staged)
+    if kind_b == BORE:
+        bore_span = pb[3] - pb[2]
+        if kind_a == CIRCLE:
+            contact, kept = _ring_in_bore(pos_a, rot_a, pa[0], 0.0, _TWO_PI, False, pos_b,
+                                          rot_b, pb[0], pb[1], pb[2], bore_span, True)
+            return [contact], [kept]
+        if kind_a == ARC:
+            contact, kept = _ring_in_bore(pos_a, rot_a, pa[0], pa[1], pa[2] - pa[1], True,
+                                          pos_b, rot_b, pb[0], pb[1], pb[2], bore_span, True)
+            return [contact], [kept]
+        if kind_a == CYLINDER:
+            return _cylinder_in_bore(pos_a, rot_a, pa[0], pa[1], pos_b, rot_b, pb[0], pb[1],
+                                     pb[2], bore_span)
+        raise ValueError(f"unsupported pair {kind_a}-{kind_b}")
+    staged = _unbounded(kind_a, pa, pos_a, rot_a, kind_b, pb, pos_b, rot_b)
+    return staged, [True] * len(staged)
+
+
+def _unbounded(kind_a, pa, pos_a, rot_a, kind_b, pb, pos_b, rot_b):
+    """Staged contacts of a canonical pair whose candidates are all kept."""
     if kind_a == PLANE:
         if kind_b == SPHERE:
             return _plane_sphere(pos_a, rot_a, pos_b, pb[0])
@@ -556,9 +717,14 @@ def _tuples(params, position, rotation):
     return params, position, rotation
 
 
-def pair_contacts(kind_a, params_a, position_a, rotation_a, kind_b, params_b, position_b,
-                  rotation_b):
-    """Candidate contacts of shape A against shape B.
+def pair_contact_slots(kind_a, params_a, position_a, rotation_a, kind_b, params_b,
+                       position_b, rotation_b):
+    """Every candidate slot of shape A against shape B, dropped or not.
+
+    A bounded face (rectangle, disc) or a bore drops the candidates outside it (or, for a face
+    with a depth, deeper than it); the shared geometry compacts the kept ones to the front,
+    this function keeps each candidate in its slot (slot k is always the same kernel
+    candidate, so one Siconos interaction follows it) and flags it.
 
     Parameters
     ----------
@@ -567,15 +733,18 @@ def pair_contacts(kind_a, params_a, position_a, rotation_a, kind_b, params_b, po
     params_a, params_b : sequence of float
         Packed parameters as ``scenarios.geometry.pack_shape_parameters`` (sphere [radius],
         box [hx, hy, hz], capsule / cylinder [radius, half_length], plane [], circle [radius],
-        arc [radius, start_angle, end_angle]).
+        arc [radius, start_angle, end_angle], rectangle [hx, hy, depth], disc [radius, depth],
+        bore [radius, half_length, start_angle, end_angle]; depth 0: unbounded).
     position_a, position_b : (3,) world position of each shape frame [L].
     rotation_a, rotation_b : (3, 3) world rotation of each shape frame.
 
     Returns
     -------
-    gap : ndarray (K,) [L]
+    gap : ndarray (K,) [L], K = candidate_count(kind_a, kind_b)
     point_a, point_b : ndarray (K, 3) world [L]
     frame : ndarray (K, 3, 3), rows (n, t1, t2), n from A toward B
+    kept : ndarray (K,) bool, False for a dropped candidate (its values are the kernel's
+        before the bound was applied, or a placeholder when the kernel computed none)
     """
     pa, pos_a, rot_a = _tuples(params_a, position_a, rotation_a)
     pb, pos_b, rot_b = _tuples(params_b, position_b, rotation_b)
@@ -584,23 +753,32 @@ def pair_contacts(kind_a, params_a, position_a, rotation_a, kind_b, params_b, po
     else:
         swap = (kind_a, kind_b) not in CANONICAL_PAIRS
     if swap:
-        staged = _canonical(kind_b, pb, pos_b, rot_b, kind_a, pa, pos_a, rot_a)
+        staged, kept = _canonical(kind_b, pb, pos_b, rot_b, kind_a, pa, pos_a, rot_a)
     else:
-        staged = _canonical(kind_a, pa, pos_a, rot_a, kind_b, pb, pos_b, rot_b)
+        staged, kept = _canonical(kind_a, pa, pos_a, rot_a, kind_b, pb, pos_b, rot_b)
     gaps, points_a, points_b, frames = [], [], [], []
-    previous_normal = None
-    tangent = (0.0, 0.0, 0.0)
     for normal, first, g in staged:
         normal = _scale(normal, 1.0 / _norm(normal))
         second = _axpy(g, normal, first)
         if swap:
             normal = _scale(normal, -1.0)
             first, second = second, first
-        if normal != previous_normal:
-            tangent = frame_tangent(normal[0], normal[1], normal[2])
-            previous_normal = normal
+        # The shared kernel caches t1 while the normal repeats; t1 is a function of n alone.
+        tangent = frame_tangent(normal[0], normal[1], normal[2])
         gaps.append(g)
         points_a.append(first)
         points_b.append(second)
         frames.append((normal, tangent, _cross(normal, tangent)))
-    return np.array(gaps), np.array(points_a), np.array(points_b), np.array(frames)
+    return (np.array(gaps, dtype=float), np.array(points_a, dtype=float).reshape(-1, 3),
+            np.array(points_b, dtype=float).reshape(-1, 3),
+            np.array(frames, dtype=float).reshape(-1, 3, 3), np.array(kept, dtype=bool))
+
+
+def pair_contacts(kind_a, params_a, position_a, rotation_a, kind_b, params_b, position_b,
+                  rotation_b):
+    """Candidate contacts of shape A against shape B, as ``scenarios.geometry`` returns them:
+    the kept slots of :func:`pair_contact_slots`, in order (gap (K,), point_a (K, 3), point_b
+    (K, 3), frame (K, 3, 3); K <= candidate_count)."""
+    gap, point_a, point_b, frame, kept = pair_contact_slots(
+        kind_a, params_a, position_a, rotation_a, kind_b, params_b, position_b, rotation_b)
+    return gap[kept], point_a[kept], point_b[kept], frame[kept]

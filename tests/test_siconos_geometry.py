@@ -34,6 +34,15 @@ def _random_parameters(kind: str, rng) -> list[float]:
         return []
     if kind == "circle":
         return [rng.uniform(0.05, 0.3)]
+    if kind == "rectangle":  # [hx, hy, depth], depth 0 (unbounded) one time in three
+        return [*rng.uniform(0.1, 0.5, size=2), rng.choice([0.0, rng.uniform(0.05, 0.3),
+                                                            rng.uniform(0.05, 0.3)])]
+    if kind == "disc":
+        return [rng.uniform(0.1, 0.5), rng.choice([0.0, rng.uniform(0.05, 0.3)])]
+    if kind == "bore":  # a full bore one time in two, else a patch of it
+        start = rng.uniform(-math.pi, math.pi)
+        span = 2 * math.pi if rng.uniform() < 0.5 else rng.uniform(0.5, 2 * math.pi)
+        return [rng.uniform(0.2, 0.4), rng.uniform(0.05, 0.5), start, start + span]
     start = rng.uniform(-math.pi, math.pi)
     return [rng.uniform(0.05, 0.3), start, start + rng.uniform(0.2, 2 * math.pi)]
 
@@ -70,15 +79,24 @@ def _compare(kind_a, shape_a, kind_b, shape_b):
                                  np.ascontiguousarray(rotation_b), gap, point_a, point_b, frame)
     w_gap, w_point_a, w_point_b, w_frame = worker.pair_contacts(
         kind_a, params_a, position_a, rotation_a, kind_b, params_b, position_b, rotation_b)
-    assert len(w_gap) == count == worker.candidate_count(kind_a, kind_b)
+    slots = worker.pair_contact_slots(kind_a, params_a, position_a, rotation_a, kind_b,
+                                      params_b, position_b, rotation_b)
+    # One slot per candidate the kernel can return; the kept slots, in order, are the shared
+    # geometry's (compacted) candidates.
+    assert all(len(values) == worker.candidate_count(kind_a, kind_b) for values in slots)
+    assert len(w_gap) == count == int(np.sum(slots[4]))
+    if not worker.drops_candidates(kind_a, kind_b):
+        assert count == worker.candidate_count(kind_a, kind_b)
     np.testing.assert_allclose(w_gap, gap[:count], rtol=0, atol=TOLERANCE)
     np.testing.assert_allclose(w_point_a, point_a[:count], rtol=0, atol=TOLERANCE)
     np.testing.assert_allclose(w_point_b, point_b[:count], rtol=0, atol=TOLERANCE)
     # Frames are dimensionless: 1e-12 is ~5000 ulp.
     np.testing.assert_allclose(w_frame, frame[:count], rtol=0, atol=TOLERANCE)
+    return count, slots
 
 
 PAIRS = sorted(worker.CANONICAL_PAIRS)
+BOUNDED_PAIRS = [pair for pair in PAIRS if worker.drops_candidates(*pair)]
 
 
 @pytest.mark.parametrize("pair", PAIRS, ids=[f"{a}-{b}" for a, b in PAIRS])
@@ -100,6 +118,48 @@ def test_worker_geometry_matches_shared_geometry(pair, swapped):
             _compare(kind_a, shape_a, kind_b, shape_b)
 
 
+def _bounded_configuration(kind_a, kind_b, rng):
+    """A face (A) with its partner (B) over it, beside it, or behind its depth; or a ring or
+    journal (A) inside a bore (B), within its length or beyond it. Canonical order."""
+    rotation_a = _random_rotation(rng)
+    if kind_b == "bore":
+        bore = _random_parameters("bore", rng)
+        tilt = quat_to_matrix(quat_normalize(np.r_[1.0, rng.normal(scale=0.1, size=3)]))
+        inner = _random_parameters(kind_a, rng)
+        inner[0] = bore[0] - rng.uniform(0.0, 0.05)
+        offset = rotation_a @ np.r_[rng.uniform(-0.05, 0.05, 2),
+                                    rng.uniform(-1.6, 1.6) * bore[1]]
+        return (inner, offset, rotation_a @ tilt), (bore, np.zeros(3), rotation_a)
+    face = _random_parameters(kind_a, rng)
+    reach = np.r_[face[0], face[1]] if kind_a == "rectangle" else np.r_[face[0], face[0]]
+    other = _random_parameters(kind_b, rng)
+    local = np.r_[rng.uniform(-1.3, 1.3, 2) * reach, rng.uniform(-0.5, 0.6)]
+    return (face, np.zeros(3), rotation_a), (other, rotation_a @ local, _random_rotation(rng))
+
+
+@pytest.mark.parametrize("pair", BOUNDED_PAIRS, ids=[f"{a}-{b}" for a, b in BOUNDED_PAIRS])
+@pytest.mark.parametrize("swapped", [False, True], ids=["canonical", "swapped"])
+def test_bounded_face_and_bore_slots_match_shared_geometry(pair, swapped):
+    kind_a, kind_b = pair
+    rng = np.random.default_rng(100 + 2 * BOUNDED_PAIRS.index(pair) + int(swapped))
+    kept = dropped = 0
+    for _ in range(300):
+        shape_a, shape_b = _bounded_configuration(kind_a, kind_b, rng)
+        if swapped:
+            count, slots = _compare(kind_b, shape_b, kind_a, shape_a)
+        else:
+            count, slots = _compare(kind_a, shape_a, kind_b, shape_b)
+        kept += count
+        dropped += len(slots[4]) - count
+        # Every slot, dropped or not, carries a finite gap and an orthonormal frame (a Siconos
+        # interaction evaluates its Jacobian whatever the slot holds); 1e-12: round-off.
+        assert np.all(np.isfinite(slots[0]))
+        for frame in slots[3]:
+            np.testing.assert_allclose(frame @ frame.T, np.eye(3), rtol=0, atol=1e-12)
+    # The configurations exercise both branches of the bound.
+    assert kept > 0 and dropped > 0
+
+
 def test_worker_frame_matches_shared_frame_everywhere():
     rng = np.random.default_rng(7)
     normals = rng.normal(size=(2000, 3))
@@ -118,3 +178,5 @@ def test_unported_pairs_have_reasons():
         assert worker.candidate_count(kind_a, kind_b) is None
         assert "Siconos" in worker.unsupported_reason(kind_a, kind_b)
     assert worker.unsupported_reason("plane", "box") == ""
+    assert worker.unsupported_reason("bore", "cylinder") == ""
+    assert worker.unsupported_reason("rectangle", "box") != ""
