@@ -7,6 +7,7 @@ returns arrays over the recorded samples, in the scene's units.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -167,6 +168,9 @@ def stiction(scene: Scene, trajectory: Trajectory, body: str, start: float = 0.0
     window = (times >= start) & (times <= (times[-1] if end is None else end))
     moved = displacement(scene, trajectory, body)[window]
     t = times[window]
+    if not len(t):
+        # No sample in the window (a run shorter than its start): nothing to judge.
+        return Stiction(math.nan, math.nan)
     moved = moved - moved[0]
     rate = float(np.polyfit(t, moved, 1)[0]) if len(t) > 1 else 0.0
     return Stiction(float(np.max(np.abs(moved))) if len(moved) else 0.0, rate)

@@ -32,3 +32,16 @@ def test_an_exception_in_a_step_is_a_crashed_run_with_the_state_it_started_from(
     assert trajectory.steps == 3
     np.testing.assert_array_equal(trajectory.positions[:4], clean.positions[:4])
     np.testing.assert_array_equal(trajectory.positions[-1], clean.positions[3])
+
+
+def test_a_stiction_window_without_samples_gives_no_verdict_instead_of_an_error():
+    # c60-on judges "stays latched" from 3 ms on; a 1 ms run has no sample there: the figures
+    # are NaN (no verdict), where they used to raise IndexError.
+    import math
+
+    from clearbench.harness import metrics
+
+    scene = get_scene("bouncing-ball-e0.5")
+    trajectory = create().run(scene, RunSettings(horizon=5 * scene.time_step))
+    stick = metrics.stiction(scene, trajectory, "ball", start=1.0, end=2.0)
+    assert math.isnan(stick.displacement) and math.isnan(stick.creep_rate)
