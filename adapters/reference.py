@@ -156,7 +156,6 @@ class ReferenceEngine(Engine):
             except (ArithmeticError, ValueError, np.linalg.LinAlgError) as error:
                 # A failure inside a kernel is an outcome of the run: the state the step
                 # started from is kept as the last sample, to reproduce it.
-                stepping += time.perf_counter() - tick
                 if next_record < len(record):
                     recorder.store(next_record, state, None)
                     next_record += 1
@@ -164,7 +163,8 @@ class ReferenceEngine(Engine):
                 message = (f"{type(error).__name__} in step {k} (from t = {state.t:.9g}; the "
                            f"last sample is that step's start): {error}")
                 break
-            stepping += time.perf_counter() - tick
+            finally:
+                stepping += time.perf_counter() - tick
             state = result.state
             taken = k
             finite = np.isfinite(state.x).all() and np.isfinite(state.v).all() and \

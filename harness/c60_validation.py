@@ -227,10 +227,8 @@ def validate(cache: Path | None = None, preset: str = "default", speed_check: bo
                    {"probe_speed": 0.5 * base_speed}, record_every=40)
         slow_curve = analysis.trip_force_curve(slow.scene, slow.trajectory)
         report.curves["trip_force"]["v/2"] = slow_curve
-        same = (abs(trip_curve.peak_force - slow_curve.peak_force)
-                <= SPEED_FORCE_TOLERANCE * slow_curve.peak_force
-                and abs(trip_curve.trip_distance - slow_curve.trip_distance)
-                <= SPEED_DISTANCE_TOLERANCE)
+        same = _same_curve(trip_curve.peak_force, slow_curve.peak_force,
+                           trip_curve.trip_distance, slow_curve.trip_distance)
         report.findings.append(
             f"Trip test at {base_speed} mm/ms and at half that speed: peak force "
             f"{trip_curve.peak_force:.4f} / {slow_curve.peak_force:.4f} N, peak at "
@@ -245,10 +243,8 @@ def validate(cache: Path | None = None, preset: str = "default", speed_check: bo
                    {"probe_speed": 0.5 * contact_speed}, record_every=40)
         slow_contact = analysis.contact_force_curve(slow.scene, slow.trajectory)
         report.curves["contact_force"]["v/2"] = slow_contact
-        same = (abs(curve.equilibrium_force - slow_contact.equilibrium_force)
-                <= SPEED_FORCE_TOLERANCE * slow_contact.equilibrium_force
-                and abs(curve.loaded_travel - slow_contact.loaded_travel)
-                <= SPEED_DISTANCE_TOLERANCE)
+        same = _same_curve(curve.equilibrium_force, slow_contact.equilibrium_force,
+                           curve.loaded_travel, slow_contact.loaded_travel)
         report.findings.append(
             f"Contact-force test at {contact_speed} and {0.5 * contact_speed} mm/ms: force at "
             f"the reference {curve.equilibrium_force:.4f} / "
@@ -256,16 +252,26 @@ def validate(cache: Path | None = None, preset: str = "default", speed_check: bo
             f"{slow_contact.loaded_travel:.4f} mm: "
             + ("the same curve within" if same else "NOT the same curve within")
             + " the stated tolerance.")
-    for key, run in report.runs.items():
-        if run.trajectory.status.value != "ok":
-            report.findings.append(f"Run {key} ({run.scene.name}) ended "
-                                   f"{run.trajectory.status.value}: {run.trajectory.message}")
+    for key, done in report.runs.items():
+        if done.trajectory.status.value != "ok":
+            report.findings.append(f"Run {key} ({done.scene.name}) ended "
+                                   f"{done.trajectory.status.value}: {done.trajectory.message}")
     return report
 
 
+def _same_curve(force: float, slow_force: float, distance: float, slow_distance: float) -> bool:
+    """A bench curve and its half-speed rerun agree: key force [N] within
+    SPEED_FORCE_TOLERANCE of the slow run's, key distance [mm] within
+    SPEED_DISTANCE_TOLERANCE."""
+    return (abs(force - slow_force) <= SPEED_FORCE_TOLERANCE * slow_force
+            and abs(distance - slow_distance) <= SPEED_DISTANCE_TOLERANCE)
+
+
 def _bench_run_usable(run: Run, report: ValidationReport) -> bool:
-    """True if a bench run ended ok with its probe loaded; otherwise a finding says what
-    happened (status, message, when the mechanism's fastest body first exceeded 10 mm/ms)."""
+    """True if a bench run ended ok with its probe loaded; otherwise a finding says that it
+    gives no curve and why (probe never loaded, when the mechanism's fastest body first
+    exceeded 10 mm/ms). A run that did not end ok is also reported with its status and message
+    by :func:`validate`, once for every run."""
     values = metrics.output_values(run.scene, run.trajectory)
     loaded = bool(np.any(values["probe_force"] > analysis.FORCE_THRESHOLD))
     if run.trajectory.status.value == "ok" and loaded:
@@ -275,8 +281,8 @@ def _bench_run_usable(run: Run, report: ValidationReport) -> bool:
     onset = (f"; the mechanism's fastest body exceeds 10 mm/ms from t = "
              f"{run.trajectory.times[fast[0]]:.2f} ms" if fast.size else "")
     report.findings.append(
-        f"{run.key} ({run.scene.name}): no curve. Status {run.trajectory.status.value}"
-        f"{', probe never loaded' if not loaded else ''}{onset}. {run.trajectory.message}")
+        f"{run.key} ({run.scene.name}): no curve (status {run.trajectory.status.value}"
+        f"{', probe never loaded' if not loaded else ''}{onset}).")
     return False
 
 
