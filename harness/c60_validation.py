@@ -373,10 +373,9 @@ MODEL_NOTES = (
     "15.2 ms and the projection tore the handle out of its bearing.",
     "Angle laws take each body's absolute angle about the law's axis in (-pi, pi] (the source's "
     "2 acos(q_w) in [0, 2 pi] likewise): a body turning through the cut makes the law's "
-    "moment jump by k 2 pi. In the contact-force test of this revision the mechanism does not "
-    "stay latched: the tripping bar turns freely from about 15 ms, the hook flips at about "
-    "25 ms, the plate passes the cut of the contact-pressure law between 28 and 29 ms, and the "
-    "run diverges before the probe touches (listed in the findings). Not yet analysed.",
+    "moment jump by k 2 pi. `benchmarks/c60_body_angles.py TRAJECTORY.npz` prints each "
+    "body's angle and the largest body speed along a run (for a bench test that gives no "
+    "curve: its cache file in .cache/c60/).",
     "Bounded faces: TRIP_1 and C3 ON 1, 2 have their nearest point beyond the face (no "
     "contact candidate; OpenCASCADE measures to the face's edge, 0.86 and 3.8 mm in the ON "
     "pose). Every other ON-pose gap agrees with OpenCASCADE within the CAD's B-spline residual "
