@@ -45,7 +45,8 @@ PRESETS: dict[str, dict] = {
     "implicit": {"theta": 1.0, "projection": True, "method": "hybrid", "localise_impacts": True},
 }
 OPTION_NAMES = ("theta", "projection", "method", "tolerance", "max_iterations",
-                "position_tolerance", "restitution_threshold", "joint_law", "localise_impacts")
+                "position_tolerance", "restitution_threshold", "joint_law", "localise_impacts",
+                "roundoff_floor")
 
 
 def availability() -> tuple[bool, str]:
@@ -89,10 +90,12 @@ class ReferenceEngine(Engine):
         unknown = sorted(set(settings.options) - set(OPTION_NAMES))
         if unknown:
             raise ValueError(f"unknown reference options {unknown}; options: {OPTION_NAMES}")
+        for flag in ("localise_impacts", "roundoff_floor"):
+            value = settings.options.get(flag)
+            if value is not None and not isinstance(value, bool):
+                raise ValueError(f"reference option {flag} must be true or false, got "
+                                 f"{value!r}")
         localise = settings.options.get("localise_impacts")
-        if localise is not None and not isinstance(localise, bool):
-            raise ValueError(f"reference option localise_impacts must be true or false, got "
-                             f"{localise!r}")
         options.update(settings.options)
         if localise is None:
             # The preset's choice, where it applies: localisation needs the projection.
@@ -104,7 +107,11 @@ class ReferenceEngine(Engine):
         method = options["method"]
         solver = SolverOptions(method="nsgs" if method == "hybrid" else method,
                                tolerance=float(options.get("tolerance", 1e-12)),
-                               max_iterations=int(options.get("max_iterations", 10_000)))
+                               max_iterations=int(options.get("max_iterations", 10_000)),
+                               # a residual below its own rounding error is a solution; on
+                               # by default, ``roundoff_floor=false`` asks for the tolerance
+                               # alone (fc3d_residual.roundoff_floor)
+                               roundoff_floor=bool(options.get("roundoff_floor", True)))
         return StepperSettings(
             time_step=settings.time_step or scene.time_step,
             theta=float(options["theta"]),
@@ -142,7 +149,7 @@ class ReferenceEngine(Engine):
         record = list(range(0, steps + 1, settings.record_every))
         if record[-1] != steps:
             record.append(steps)
-        recorder = _Recorder(scene, system, len(record), h)
+        recorder = _Recorder(scene, system, len(record), h, config.solver.tolerance)
         recorder.store(0, state, None)
         build_seconds = time.perf_counter() - start
         status, message = RunStatus.OK, ""
@@ -189,6 +196,7 @@ class ReferenceEngine(Engine):
             "solver": config.method, "tolerance": config.solver.tolerance,
             "position_tolerance": config.position_tolerance,
             "unconverged_steps": recorder.unconverged,
+            "roundoff_steps": recorder.roundoff_steps,
             "unconverged_projections": recorder.unconverged_projection,
             "solver_seconds": recorder.solver_seconds,
             "contact_sweeps": recorder.contact_sweeps,
@@ -232,9 +240,12 @@ class _Recorder:
     """Collects samples into preallocated arrays; statistics of skipped steps are
     accumulated so that an unconverged step is never lost by subsampling."""
 
-    def __init__(self, scene: Scene, system, samples: int, h: float):
+    def __init__(self, scene: Scene, system, samples: int, h: float, tolerance: float):
         self.scene = scene
         self.h = h
+        self.tolerance = tolerance
+        # steps whose solve was accepted on its round-off floor (residual above tolerance)
+        self.roundoff_steps = 0
         nb = system.body_count
         npair = system.pair_count
         self.com = np.array([b.center_of_mass for b in scene.bodies], dtype=float)
@@ -267,6 +278,8 @@ class _Recorder:
         self.split_steps += stats.substeps > 1
         self._iterations += stats.solver_iterations
         self._residual = max(self._residual, stats.solver_residual)
+        if stats.solver_converged and stats.solver_residual > self.tolerance:
+            self.roundoff_steps += 1
         if not stats.solver_converged:
             self._converged = False
             self.unconverged.append(self._step)

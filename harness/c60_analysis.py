@@ -182,7 +182,7 @@ def contact_force_curve(scene: Scene, trajectory: Trajectory) -> ContactForceCur
     x = values["probe_x"] - values["probe_x"][0]
     times = trajectory.times
     driver = next(d for d in scene.drivers if d.name == "probe_x")
-    start, reach, leave, end = driver.times[1:5]
+    start, reach, leave, end = driver.times[-4:]
     forward = (times >= start) & (times <= reach)
     hold = (times >= 0.5 * (reach + leave)) & (times <= leave)
     backward = (times >= leave) & (times <= end)

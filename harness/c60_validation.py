@@ -292,8 +292,9 @@ def _probe_speed(scene: Scene) -> float:
                   and d.component in ("x", "y") and len(d.times) > 1)
     if driver.quantity == "velocity":
         return float(driver.values[-1])
+    # A position profile ends forward stroke, hold, backward stroke: the forward stroke's speed.
     times, values = driver.times, driver.values
-    return float((values[2] - values[1]) / (times[2] - times[1]))
+    return float((values[-3] - values[-4]) / (times[-3] - times[-4]))
 
 
 def _first_contact_phase(run: Run) -> str:

@@ -224,6 +224,20 @@ class SolverOptions:
     residual_check_interval : int
         NSGS: the full residual (one product W r) is evaluated every this many sweeps and on
         the last one.
+    roundoff_floor : bool
+        Also accept a residual above ``tolerance`` when it is below the bound on its own
+        rounding error (:func:`fc3d_residual.roundoff_floor`): at such an r the computed
+        residual cannot be told from that of the exact solution. The result says so in its
+        ``message``. Off by default (the FCLIB comparisons use Siconos's plain test); the
+        reference stepper turns it on, since its tolerance (1e-12) sits near that bound on
+        ill-conditioned problems (redundant bearing rings: cond(W) ~ 1e19).
+    stall_window : int
+        0 (default): iterate up to ``max_iterations``. n > 0: stop early, as ``STALLED``, when
+        the residual's mean rate of decrease over the last n checks (NSGS) or iterations
+        (Newton), if kept up, would not reach the tolerance within twice the iterations left
+        (:func:`fc3d_residual.hopeless`). A solve stopped so could at best have converged by a
+        late acceleration; the reference stepper uses it (NSGS crawling at 1e-8 on a singular W
+        would otherwise run its 10,000 sweeps before the next start is tried).
     """
 
     method: str = "nsgs"
@@ -234,6 +248,8 @@ class SolverOptions:
     local_tolerance: float = 1e-14
     local_max_iterations: int = 30
     residual_check_interval: int = 1
+    roundoff_floor: bool = False
+    stall_window: int = 0
 
     def __post_init__(self) -> None:
         if self.method not in METHODS:
@@ -247,6 +263,8 @@ class SolverOptions:
             raise ValueError(f"tolerance must be > 0, got {self.tolerance}")
         if self.max_iterations < 1:
             raise ValueError(f"max_iterations must be >= 1, got {self.max_iterations}")
+        if self.stall_window < 0:
+            raise ValueError(f"stall_window must be >= 0, got {self.stall_window}")
         if self.local_max_iterations < 1 or self.residual_check_interval < 1:
             raise ValueError("local_max_iterations and residual_check_interval must be >= 1")
 

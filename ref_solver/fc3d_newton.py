@@ -24,13 +24,20 @@ from numba import njit
 
 from .contact_problem import (
     ContactProblem,
+    Normalisation,
     SolverOptions,
     SolverResult,
     SolverStatus,
 )
 from .fc3d_local import LOCAL_KIND, alart_curnier
 from .fc3d_nsgs import bilateral_operator_of, diagonal_blocks, nsgs_kernel
-from .fc3d_residual import residual_both
+from .fc3d_residual import (
+    abs_operator_of,
+    floor_message,
+    hopeless,
+    residual_both,
+    roundoff_floor,
+)
 
 logger = logging.getLogger(__name__)
 
@@ -195,17 +202,33 @@ def solve_newton(
         _, rel_q, rel_max = residual_both(r_, u_, q, mu, nb)
         return u_, rel_q, rel_max, (rel_max if use_max else rel_q)
 
+    normalisation = Normalisation.MAX if use_max else Normalisation.Q
     u, residual_q, residual_max, residual = measure(r)
     while True:
         if residual <= options.tolerance:
             status = SolverStatus.CONVERGED
             break
+        if options.roundoff_floor and math.isfinite(residual):
+            floor = roundoff_floor(abs_operator_of(problem), r, u, q, mu, normalisation)
+            if residual <= floor:
+                status = SolverStatus.CONVERGED
+                message = floor_message(residual, floor, options.tolerance)
+                break
         if not math.isfinite(residual):
             status = SolverStatus.NUMERICAL_FAILURE
             message = "non-finite residual"
             break
         if iteration >= options.max_iterations:
             status = SolverStatus.MAX_ITERATIONS
+            break
+        window = options.stall_window
+        if 0 < window < len(history) and hopeless(
+                history[-1 - window], residual, window, options.tolerance,
+                options.max_iterations - iteration):
+            status = SolverStatus.STALLED
+            message = (f"stopped after {iteration} iterations at residual {residual:.3g}: at "
+                       f"its rate over the last {window} it would not reach "
+                       f"{options.tolerance:.3g} within {options.max_iterations}")
             break
         iteration += 1
         merit = alart_curnier_system(r, u, mu, nb, rho_n, rho_t, rho_b, phi, A, B, True)
@@ -243,7 +266,7 @@ def solve_newton(
             nsgs_kernel(W.indptr, W.indices, W.data, q, mu, nb, bilateral_operator_of(problem),
                         r, u_tmp, LOCAL_KIND["ac"], options.tolerance, use_max, _RESCUE_SWEEPS,
                         options.local_tolerance, options.local_max_iterations, _RESCUE_SWEEPS,
-                        np.full(_RESCUE_SWEEPS, np.nan))
+                        np.full(_RESCUE_SWEEPS, np.nan), 0)
         u, residual_q, residual_max, residual = measure(r, u_next)
         best_residual = min(best_residual, residual)
         history.append(residual)

@@ -19,12 +19,21 @@ from numba import njit
 
 from .contact_problem import (
     ContactProblem,
+    Normalisation,
     SolverOptions,
     SolverResult,
     SolverStatus,
 )
 from .fc3d_local import LOCAL_FAILED, LOCAL_KIND, N_MAT, N_VEC, solve_local
-from .fc3d_residual import csr_matvec_plus, natural_map_squared, normalised
+from .fc3d_residual import (
+    abs_operator_of,
+    csr_matvec_plus,
+    floor_message,
+    hopeless,
+    natural_map_squared,
+    normalised,
+    roundoff_floor,
+)
 
 logger = logging.getLogger(__name__)
 
@@ -91,7 +100,7 @@ def nsgs_kernel(
     indptr: np.ndarray, indices: np.ndarray, data: np.ndarray, q: np.ndarray, mu: np.ndarray,
     n_bilateral: int, bilateral_operator: np.ndarray, r: np.ndarray, u: np.ndarray, kind: int,
     tolerance: float, use_max: bool, max_sweeps: int, local_tolerance: float,
-    local_max_iterations: int, check_interval: int, history: np.ndarray,
+    local_max_iterations: int, check_interval: int, history: np.ndarray, stall_window: int,
 ) -> tuple[int, int, float, float, int, int]:
     """Run NSGS sweeps on r (in place); u receives W r + q at the last residual check.
 
@@ -163,6 +172,12 @@ def nsgs_kernel(
                 return (0, sweep + 1, normalised(abs_residual, norm_q, norm_r, norm_u, False),
                         normalised(abs_residual, norm_q, norm_r, norm_u, True), failures,
                         n_checks)
+            if 0 < stall_window < n_checks and hopeless(
+                    history[n_checks - 1 - stall_window], residual,
+                    stall_window * check_interval, tolerance, max_sweeps - sweep - 1):
+                return (2, sweep + 1, normalised(abs_residual, norm_q, norm_r, norm_u, False),
+                        normalised(abs_residual, norm_q, norm_r, norm_u, True), failures,
+                        n_checks)
     return (1, max_sweeps, normalised(abs_residual, norm_q, norm_r, norm_u, False),
             normalised(abs_residual, norm_q, norm_r, norm_u, True), failures, n_checks)
 
@@ -197,15 +212,29 @@ def solve_nsgs(
         LOCAL_KIND[options.local_solver],
         options.tolerance, use_max, options.max_iterations, options.local_tolerance,
         options.local_max_iterations, options.residual_check_interval, history,
+        options.stall_window,
     )
     if code == 0:
         return SolverResult(r, u, sweeps, residual_max if use_max else residual_q, residual_q,
                             residual_max, True, SolverStatus.CONVERGED, method, "", failures,
                             history[:n_checks].copy())
     status = _STATUS_CODES[code]
+    residual = residual_max if use_max else residual_q
+    if status in (SolverStatus.MAX_ITERATIONS, SolverStatus.STALLED) and options.roundoff_floor:
+        floor = roundoff_floor(abs_operator_of(problem), r, u, problem.q, problem.mu,
+                               Normalisation.MAX if use_max else Normalisation.Q)
+        if residual <= floor:
+            return SolverResult(r, u, sweeps, residual, residual_q, residual_max, True,
+                                SolverStatus.CONVERGED, method,
+                                floor_message(residual, floor, options.tolerance), failures,
+                                history[:n_checks].copy())
     if status is SolverStatus.MAX_ITERATIONS:
         message = f"{sweeps} sweeps done, residual {history[n_checks - 1]:.3g} > " \
                   f"{options.tolerance:.3g}"
+    elif status is SolverStatus.STALLED:
+        message = (f"stopped after {sweeps} sweeps at residual {history[n_checks - 1]:.3g}: "
+                   f"at its rate over the last {options.stall_window} checks it would not "
+                   f"reach {options.tolerance:.3g} within the {options.max_iterations} sweeps")
     else:
         message = f"non-finite residual after {sweeps} sweeps"
     return SolverResult(

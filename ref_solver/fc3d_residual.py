@@ -80,6 +80,63 @@ def normalised(abs_residual: float, norm_q: float, norm_r: float, norm_u: float,
     return abs_residual
 
 
+def roundoff_floor(W_abs, r: np.ndarray, u: np.ndarray, q: np.ndarray, mu: np.ndarray,
+                   normalisation: Normalisation) -> float:
+    """Bound on the rounding error of the normalised residual evaluated at ``r``.
+
+    u = W r + q computed in floating point is off by at most gamma_(m+1) (|W| |r| + |q|) per
+    row (Higham, *Accuracy and Stability of Numerical Algorithms*, 2002, Sec. 3.5, with
+    gamma_n = n eps / (1 - n eps)); the modified velocity u + [mu |u_T|, 0, 0] carries at most
+    (1 + mu) times that, the projection on the cone does not enlarge it (non-expansive), and
+    forming r - P(.) adds 2 eps |r|. A residual below this bound cannot be told from zero: at
+    the exact solution the computed residual may be this large.
+
+    Parameters
+    ----------
+    W_abs : ndarray or scipy.sparse matrix, shape (m, m)
+        |W|, elementwise.
+    r, u, q : ndarray, shape (m,)
+        Impulses, their velocities W r + q, the free velocities.
+    mu : ndarray, shape (nc,)
+    normalisation : Normalisation
+        That of the residual it is compared with.
+    """
+    m = q.size
+    eps = np.finfo(np.float64).eps
+    gamma = (m + 1) * eps / (1.0 - (m + 1) * eps)
+    velocity_error = np.asarray(W_abs @ np.abs(r)).ravel() + np.abs(q)
+    amplification = 1.0 + (float(mu.max()) if mu.size else 0.0)
+    norm_r = math.sqrt(r.dot(r))
+    bound = amplification * gamma * math.sqrt(velocity_error.dot(velocity_error)) \
+        + 2.0 * eps * norm_r
+    return normalised(bound, math.sqrt(q.dot(q)), norm_r, math.sqrt(u.dot(u)),
+                      normalisation is Normalisation.MAX)
+
+
+@njit(cache=True)
+def hopeless(earlier: float, now: float, window: int, tolerance: float, left: int) -> bool:
+    """True when going from ``earlier`` to ``now`` over ``window`` iterations, at the same mean
+    rate, would not bring the residual to ``tolerance`` within ``2 * left`` more iterations
+    (no decrease at all counts as hopeless). Used by ``SolverOptions.stall_window``."""
+    if now <= tolerance:
+        return False
+    if not now < earlier:
+        return True
+    rate = math.log(now / earlier) / window  # < 0: log of the mean factor per iteration
+    return math.log(tolerance / now) / rate > 2.0 * left
+
+
+def abs_operator_of(problem) -> np.ndarray | sp.csr_matrix:
+    """|W| of ``problem`` (dense or CSR as its W), computed once per problem."""
+    return problem.derived("abs_W", lambda p: abs(p.W))
+
+
+def floor_message(residual: float, floor: float, tolerance: float) -> str:
+    """What a result accepted on :func:`roundoff_floor` says."""
+    return (f"converged to round-off: residual {residual:.3g} > tolerance {tolerance:.3g} "
+            f"but below its rounding-error bound {floor:.3g}")
+
+
 def residual_both(
     r: np.ndarray, u: np.ndarray, q: np.ndarray, mu: np.ndarray, n_bilateral: int
 ) -> tuple[float, float, float]:

@@ -68,6 +68,13 @@ from .system import MultibodySystem, State
 #: Halvings of a projection correction that does not reduce the largest violation before the
 #: projection gives up (a correction scaled by 2^-8 that still does not help is not a descent).
 MAX_PROJECTION_HALVINGS = 8
+#: Windows of the hybrid solver's early stop (``SolverOptions.stall_window``): Newton converges
+#: quadratically or not at all (on the C-60's singular bearing problems it reaches 1e-12 in
+#: 5-13 iterations, then creeps by 1 % in 190), so 10 iterations tell; NSGS converges linearly
+#: and its rate may still grow after hundreds of sweeps (one C-60 problem: 2.7e-2, 1.6e-3 after
+#: 500 sweeps, 1.2e-4 after 1000), so 1000 sweeps, a tenth of its 10,000 cap.
+NEWTON_STALL_WINDOW = 10
+NSGS_STALL_WINDOW = 1000
 
 
 @dataclass(frozen=True)
@@ -118,7 +125,8 @@ class StepperSettings:
     time_step: float
     theta: float = 0.5
     projection: bool = True
-    solver: SolverOptions = field(default_factory=lambda: SolverOptions(tolerance=1e-12))
+    solver: SolverOptions = field(
+        default_factory=lambda: SolverOptions(tolerance=1e-12, roundoff_floor=True))
     position_tolerance: float = 1e-12
     max_projection_iterations: int = 30
     max_activation_rounds: int = 20
@@ -496,14 +504,18 @@ class MoreauJeanStepper:
         not converged, semismooth Newton from where NSGS stopped, then from the warm start, then
         from zero, then NSGS to its full cap from zero and from where it stopped, keeping the
         first that converges (else the smallest residual); after a step that needed Newton,
-        Newton from the warm start is tried first. Redundant
+        Newton from the warm start is tried first. An attempt stops early when its rate of
+        progress could not reach the tolerance within its cap (``SolverOptions.stall_window``:
+        :data:`NEWTON_STALL_WINDOW`, :data:`NSGS_STALL_WINDOW`), so that the next start is
+        tried sooner. Redundant
         contacts (the two rings of a bearing) make W singular: NSGS crawls there and Newton can
         stall from a poor start, while another start converges in a few iterations.
         """
         cfg = self.settings
         if cfg.method != "hybrid":
             return solve_contact_problem(problem, replace(cfg.solver, method=cfg.method), r0=r0)
-        newton = replace(cfg.solver, method="newton", max_iterations=200)
+        newton = replace(cfg.solver, method="newton", max_iterations=200,
+                         stall_window=NEWTON_STALL_WINDOW)
         iterations = 0
         if self._newton_first:
             # The last problem needed Newton: consecutive steps' problems are alike (the same
@@ -521,7 +533,7 @@ class MoreauJeanStepper:
             return replace(nsgs_first, iterations=iterations)
         if not self._newton_first or nsgs_first.residual < best.residual:
             best = nsgs_first
-        nsgs = replace(cfg.solver, method="nsgs")
+        nsgs = replace(cfg.solver, method="nsgs", stall_window=NSGS_STALL_WINDOW)
         attempts = ((newton, nsgs_first.r), (newton, r0), (newton, None), (nsgs, None),
                     (nsgs, nsgs_first.r))
         for options, start in attempts:
