@@ -234,7 +234,7 @@ class SolverOptions:
     stall_window : int
         0 (default): iterate up to ``max_iterations``. n > 0: stop early, as ``STALLED``, when
         the residual's mean rate of decrease over the last n checks (NSGS) or iterations
-        (Newton), if kept up, would not reach the tolerance within twice the iterations left
+        (Newton), if kept up, would not reach the tolerance within the iterations left
         (:func:`fc3d_residual.hopeless`). A solve stopped so could at best have converged by a
         late acceleration; the reference stepper uses it (NSGS crawling at 1e-8 on a singular W
         would otherwise run its 10,000 sweeps before the next start is tried).

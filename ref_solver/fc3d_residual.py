@@ -115,15 +115,16 @@ def roundoff_floor(W_abs, r: np.ndarray, u: np.ndarray, q: np.ndarray, mu: np.nd
 
 @njit(cache=True)
 def hopeless(earlier: float, now: float, window: int, tolerance: float, left: int) -> bool:
-    """True when going from ``earlier`` to ``now`` over ``window`` iterations, at the same mean
-    rate, would not bring the residual to ``tolerance`` within ``2 * left`` more iterations
-    (no decrease at all counts as hopeless). Used by ``SolverOptions.stall_window``."""
+    """True when going on from ``now`` at the mean rate of the last ``window`` iterations (from
+    ``earlier``) would not bring the residual to ``tolerance`` within the ``left`` iterations
+    the cap allows (no decrease at all counts as hopeless). Used by
+    ``SolverOptions.stall_window``."""
     if now <= tolerance:
         return False
     if not now < earlier:
         return True
     rate = math.log(now / earlier) / window  # < 0: log of the mean factor per iteration
-    return math.log(tolerance / now) / rate > 2.0 * left
+    return math.log(tolerance / now) / rate > left
 
 
 def abs_operator_of(problem) -> np.ndarray | sp.csr_matrix:
