@@ -357,10 +357,12 @@ MODEL_NOTES = (
     "initial centre-of-mass position in world as z0: the force acts 21 mm from the pivot "
     "(27.1 N mm about it instead of the law's 10.1). The default scene reproduces this; "
     "`handle_spring_arm='design'` applies the evident intent.",
-    "Contact-force test: with the source's handle arm the handle leaves its ON stop once the "
-    "fixed contact is removed and the mechanism opens before the probe arrives (handle turned "
-    "1.7 rad, latch released at 3.5 ms); the test therefore runs with the design arm, with "
-    "which the mechanism stays latched, as the study's did.",
+    "Contact-force test: the probe settles at the reference (the fixed contact's place), "
+    "retreats 2.2 mm at 0.5 mm/ms, then gives the curve forward to the reference and back. "
+    "Once the moving contact rests on its stop C6 (about 2.0 mm back) nothing loads the "
+    "mechanism: with the source's handle arm the handle then leaves its ON pose within 1 ms "
+    "and the mechanism opens, so the test runs with the design arm, with which it stays "
+    "latched (see clearbench.scenarios.c60_bench).",
     "Contact-pressure spring: M = 244.46 (theta_mc - theta_plate + 76.54 deg + 0.49 rad) "
     "N mm in this version of the source; its comment lists 0.6547 and 0.9599 rad as other "
     "preloads.",

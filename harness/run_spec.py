@@ -19,6 +19,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import clearbench
 from clearbench.scenarios.registry import get_entry, scene_names
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.serialization import load_scene_file, scene_to_dict
@@ -189,8 +190,10 @@ class RunSpec:
 
     @property
     def key_fields(self) -> dict:
-        """What identifies the run (hashed into :attr:`key`)."""
+        """What identifies the run (hashed into :attr:`key`): the scene, the engine and its
+        settings, and the package's code (:func:`clearbench.source_digest`)."""
         return {
+            "code": clearbench.source_digest(),
             "scene_hash": self.scene.content_hash,
             "engine": self.engine.name,
             "preset": self.engine.preset,

@@ -113,6 +113,17 @@ def test_engine_labels():
         parse_engine_label("a b")
 
 
+def test_run_key_changes_with_the_code(monkeypatch):
+    # A stored result of other code is never served as this code's (an adapter fix must not
+    # need --rerun); the digest is of the sources' contents, the same on every clone.
+    import clearbench
+
+    base = fake_spec().key
+    assert clearbench.source_digest() == clearbench.source_digest()
+    monkeypatch.setattr(clearbench, "_SOURCE_DIGEST", "0" * 16)
+    assert fake_spec().key != base
+
+
 def test_run_key_identifies_the_physics_and_settings_only():
     base = fake_spec()
     assert fake_spec().key == base.key
