@@ -222,7 +222,7 @@ def solve_newton(
             status = SolverStatus.MAX_ITERATIONS
             break
         window = options.stall_window
-        if 0 < window < len(history) and hopeless(
+        if 0 < window < len(history) and iteration >= options.stall_after and hopeless(
                 history[-1 - window], residual, window, options.tolerance,
                 options.max_iterations - iteration):
             status = SolverStatus.STALLED
@@ -266,7 +266,7 @@ def solve_newton(
             nsgs_kernel(W.indptr, W.indices, W.data, q, mu, nb, bilateral_operator_of(problem),
                         r, u_tmp, LOCAL_KIND["ac"], options.tolerance, use_max, _RESCUE_SWEEPS,
                         options.local_tolerance, options.local_max_iterations, _RESCUE_SWEEPS,
-                        np.full(_RESCUE_SWEEPS, np.nan), 0)
+                        np.full(_RESCUE_SWEEPS, np.nan), 0, 0)
         u, residual_q, residual_max, residual = measure(r, u_next)
         best_residual = min(best_residual, residual)
         history.append(residual)

@@ -101,6 +101,7 @@ def nsgs_kernel(
     n_bilateral: int, bilateral_operator: np.ndarray, r: np.ndarray, u: np.ndarray, kind: int,
     tolerance: float, use_max: bool, max_sweeps: int, local_tolerance: float,
     local_max_iterations: int, check_interval: int, history: np.ndarray, stall_window: int,
+    stall_after: int,
 ) -> tuple[int, int, float, float, int, int]:
     """Run NSGS sweeps on r (in place); u receives W r + q at the last residual check.
 
@@ -172,7 +173,7 @@ def nsgs_kernel(
                 return (0, sweep + 1, normalised(abs_residual, norm_q, norm_r, norm_u, False),
                         normalised(abs_residual, norm_q, norm_r, norm_u, True), failures,
                         n_checks)
-            if 0 < stall_window < n_checks and hopeless(
+            if 0 < stall_window < n_checks and n_checks >= stall_after and hopeless(
                     history[n_checks - 1 - stall_window], residual,
                     stall_window * check_interval, tolerance, max_sweeps - sweep - 1):
                 return (2, sweep + 1, normalised(abs_residual, norm_q, norm_r, norm_u, False),
@@ -212,7 +213,7 @@ def solve_nsgs(
         LOCAL_KIND[options.local_solver],
         options.tolerance, use_max, options.max_iterations, options.local_tolerance,
         options.local_max_iterations, options.residual_check_interval, history,
-        options.stall_window,
+        options.stall_window, options.stall_after,
     )
     if code == 0:
         return SolverResult(r, u, sweeps, residual_max if use_max else residual_q, residual_q,
