@@ -132,6 +132,17 @@ def test_stall_window_changes_nothing_on_a_solve_that_converges(method):
 def test_stall_window_is_validated():
     with pytest.raises(ValueError, match="stall_window"):
         SolverOptions(stall_window=-1)
+    with pytest.raises(ValueError, match="stall_after"):
+        SolverOptions(stall_after=-1)
+
+
+def test_stall_after_delays_the_early_stop():
+    problem = _crawling_problem()
+    options = SolverOptions(tolerance=1e-12, max_iterations=20_000, stall_window=100)
+    early = solve_contact_problem(problem, options)
+    late = solve_contact_problem(problem, dataclasses.replace(options, stall_after=5000))
+    assert early.status is late.status is SolverStatus.STALLED
+    assert early.iterations < 5000 <= late.iterations
 
 
 def test_reference_engine_uses_the_floor_by_default_and_counts_its_steps():
