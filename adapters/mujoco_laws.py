@@ -10,11 +10,11 @@ Law loads depend on the configuration only (angles, a distance), not on velociti
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from clearbench.ref_solver.forces import element_forces
+from clearbench.ref_solver.forces import element_forces, no_angle_memory, remember_angles
 from clearbench.ref_solver.system import FORCE_ANGLE_LAW, FORCE_DISTANCE_LAW
 from clearbench.scenarios.loads import AngleLawLoad, DistanceLawLoad
 from clearbench.scenarios.scene import Scene
@@ -56,6 +56,10 @@ class LawForces:
         Element parameters (layout in :mod:`clearbench.ref_solver.forces`).
     body_ids : (nb,) int array
         MuJoCo body id of each body of the scene (in ``scene.expanded.bodies`` order).
+    angle_memory : (ne, 2) array
+        The angle laws' continuous angles at the last :meth:`apply` (NaN: none yet; see
+        ``ref_solver.forces.remember_angles``), so that a body turning through the cut of its
+        raw angle does not make its law jump by k 2 pi.
     """
 
     kinds: np.ndarray
@@ -63,6 +67,11 @@ class LawForces:
     body_b: np.ndarray
     parameters: np.ndarray
     body_ids: np.ndarray
+    angle_memory: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+
+    def __post_init__(self) -> None:
+        if self.angle_memory.shape != (self.kinds.shape[0], 2):
+            self.angle_memory = no_angle_memory(self.kinds.shape[0])
 
     def wrenches(self, data, time: float = 0.0) -> np.ndarray:
         """(nb, 6) force [F] and moment about the centre of mass [F L], both in world axes, of
@@ -73,7 +82,7 @@ class LawForces:
         zeros = np.zeros_like(x)  # the laws read no velocity
         out = np.zeros((len(ids), 6))
         element_forces(time, x, rotation, zeros, zeros, self.kinds, self.body_a, self.body_b,
-                       self.parameters, False, out)
+                       self.parameters, self.angle_memory, False, out)
         # element_forces gives moments in body axes; xfrc_applied wants world axes.
         out[:, 3:] = np.einsum("bij,bj->bi", rotation, out[:, 3:])
         return out
@@ -82,6 +91,9 @@ class LawForces:
         """Add the law wrenches to ``data.xfrc_applied`` (applied at each centre of mass)."""
         wrench = self.wrenches(data, float(data.time))
         np.add.at(data.xfrc_applied, self.body_ids, wrench)
+        rotation = np.ascontiguousarray(data.xmat[self.body_ids].reshape(-1, 3, 3))
+        remember_angles(rotation, self.kinds, self.body_a, self.body_b, self.parameters,
+                        self.angle_memory)
 
 
 def law_forces(scene: Scene, model) -> LawForces | None:

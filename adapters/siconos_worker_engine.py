@@ -399,6 +399,8 @@ class Loads:
             for target in targets:
                 self.per_body[target].append(load)
         self._unwrap = {}
+        # (law name, body name) -> the body's continuous angle at the last step
+        self.angle_memory = {}
         self.nonfinite = False  # set when a load evaluated to NaN / inf (a diverging run)
 
     def has_loads(self, name):
@@ -479,8 +481,7 @@ class Loads:
             total = float(load.get("offset", 0.0))
             for body_name, coefficient in zip(load["angle_bodies"], load["angle_coefficients"],
                                               strict=True):
-                q, _ = self.bodies[body_name].state()
-                total += float(coefficient) * twist_angle(geometry.quat_to_matrix(q[3:7]), axis)
+                total += float(coefficient) * self._law_angle(load, body_name, axis)
             return float(load.get("stiffness", 0.0)) * total
         point_a, _, _, _ = self._point(self.bodies[load["body_a"]],
                                        load.get("point_a", (0.0, 0.0, 0.0)))
@@ -489,6 +490,22 @@ class Loads:
         d = point_b - point_a
         return float(load.get("stiffness", 0.0)) * (
             float(load.get("rest_length", 0.0)) - math.sqrt(float(d @ d)))
+
+    def _law_angle(self, load, body_name, axis):
+        """The body's angle about the law's axis, continuous across steps (``continuous_angle``
+        with the angle remembered at the last step)."""
+        q, _ = self.bodies[body_name].state()
+        raw = twist_angle(geometry.quat_to_matrix(q[3:7]), axis)
+        return continuous_angle(raw, self.angle_memory.get((load["name"], body_name), math.nan))
+
+    def remember_angles(self):
+        """After a step: remember every angle law's continuous body angles."""
+        for load in self.loads:
+            if load["kind"] == "angle_law":
+                axis = [float(v) for v in load.get("axis", (0.0, 0.0, 1.0))]
+                for body_name in load["angle_bodies"]:
+                    self.angle_memory[(load["name"], body_name)] = self._law_angle(
+                        load, body_name, axis)
 
     def _torsion(self, load, name):
         body_a = self.bodies[load["body_a"]]
@@ -524,6 +541,15 @@ def twist_angle(rotation, axis):
     vee_z = rotation[1, 0] - rotation[0, 1]
     trace = rotation[0, 0] + rotation[1, 1] + rotation[2, 2]
     return 2.0 * math.atan2(axis[0] * vee_x + axis[1] * vee_y + axis[2] * vee_z, 1.0 + trace)
+
+
+def continuous_angle(raw, previous):
+    """``raw`` plus the whole turns that bring it nearest ``previous`` (NaN: raw as is); the
+    worker's copy of ``ref_solver.forces.continuous_angle`` (no numba in this interpreter)."""
+    if math.isnan(previous):
+        return raw
+    turns = round((previous - raw) / (2.0 * math.pi))
+    return raw if turns == 0 else raw + 2.0 * math.pi * turns
 
 
 def _law_action(application, scalar, scalar_is_moment, rotation, com):
@@ -759,6 +785,7 @@ class SiconosModel:
                 status, message = "failed", f"Siconos raised at step {k}: {error}"
                 break
             elapsed = time.perf_counter() - tick
+            self.loads.remember_angles()
             step_iterations = int(options.iparam[sn.SICONOS_IPARAM_ITER_DONE])
             step_residual = float(options.dparam[sn.SICONOS_DPARAM_RESIDU])
             newton_total += int(simulation.getNewtonNbIterations())

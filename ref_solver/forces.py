@@ -18,7 +18,8 @@ the centre of mass, body axes):
 - angle law (one element per application of a scene's law load; at most two law bodies, A and
   B, equal when the law has one body): [0:3] world axis, [3] stiffness, [4] offset, [5], [6]
   coefficients of theta(A) and theta(B); s = k (offset + c_A theta_A + c_B theta_B), theta the
-  absolute twist angle of the body about the axis (2 atan2(a . vee(R - R^T), 1 + tr R)).
+  body's twist angle about the axis (2 atan2(a . vee(R - R^T), 1 + tr R), in (-pi, pi]) made
+  continuous by ``angle_memory`` (see :func:`continuous_angle`).
 - distance law: [0:3] point on A, [3:6] point on B, [17] stiffness, [18] rest length;
   s = k (rest - |p_B - p_A|).
 - both laws, the application: [7] 0 on A / 1 on B, [8] 0 force / 1 moment, [9] 0 world / 1 body
@@ -91,6 +92,41 @@ def twist_angle(rotation, axis):
     return 2.0 * math.atan2(axis[0] * vee_x + axis[1] * vee_y + axis[2] * vee_z, 1.0 + trace)
 
 
+@njit(cache=True)
+def continuous_angle(raw, previous):
+    """``raw`` (in (-pi, pi]) plus the whole turns that bring it nearest ``previous`` [rad].
+
+    ``previous`` is the law body's continuous angle at the last step (NaN: none yet, the raw
+    angle is taken). A body turning through the cut of the raw angle would otherwise make its
+    angle law's moment jump by k 2 pi; as long as a body turns less than pi in one step the
+    angle stays continuous. Returns ``raw`` unchanged (bitwise) while no turn is added.
+    """
+    if math.isnan(previous):
+        return raw
+    turns = round((previous - raw) / (2.0 * math.pi))
+    if turns == 0.0:
+        return raw
+    return raw + 2.0 * math.pi * turns
+
+
+@njit(cache=True)
+def remember_angles(rotation, kinds, body_a, body_b, parameters, angle_memory):
+    """Store in ``angle_memory`` (nf, 2) each angle law's continuous angles of its bodies A and B
+    at the configuration ``rotation`` (nb, 3, 3): called once per step, after the step."""
+    for e in range(kinds.shape[0]):
+        if kinds[e] == FORCE_ANGLE_LAW:
+            axis = parameters[e, 0:3]
+            angle_memory[e, 0] = continuous_angle(twist_angle(rotation[body_a[e]], axis),
+                                                  angle_memory[e, 0])
+            angle_memory[e, 1] = continuous_angle(twist_angle(rotation[body_b[e]], axis),
+                                                  angle_memory[e, 1])
+
+
+def no_angle_memory(n_elements: int) -> np.ndarray:
+    """An ``angle_memory`` (n_elements, 2) with no angle remembered (raw angles)."""
+    return np.full((n_elements, 2), np.nan)
+
+
 @njit(cache=True, inline="always")
 def _apply_law(out, x, rotation, body, prm, scalar):
     """Apply ``scalar`` through the application stored in prm[8:17] to ``body``."""
@@ -106,12 +142,13 @@ def _apply_law(out, x, rotation, body, prm, scalar):
 
 
 @njit(cache=True)
-def element_forces(t, x, rotation, v, omega, kinds, body_a, body_b, parameters, springs_only,
-                   out):
+def element_forces(t, x, rotation, v, omega, kinds, body_a, body_b, parameters, angle_memory,
+                   springs_only, out):
     """Add the force elements' generalised forces to ``out`` (nb, 6).
 
-    With ``springs_only`` the time-switched point forces and moments are skipped (used for the
-    stiffness Jacobian).
+    ``angle_memory`` (nf, 2): the angle laws' continuous angles at the last step (NaN: none;
+    :func:`remember_angles`). With ``springs_only`` the time-switched point forces and moments
+    are skipped (used for the stiffness Jacobian).
     """
     for e in range(kinds.shape[0]):
         kind = kinds[e]
@@ -143,8 +180,8 @@ def element_forces(t, x, rotation, v, omega, kinds, body_a, body_b, parameters, 
             _add_torque(out, a, rotation, -moment * axis)
         elif kind == FORCE_ANGLE_LAW:
             axis = prm[0:3]
-            theta_a = twist_angle(rotation[a], axis)
-            theta_b = twist_angle(rotation[b], axis)
+            theta_a = continuous_angle(twist_angle(rotation[a], axis), angle_memory[e, 0])
+            theta_b = continuous_angle(twist_angle(rotation[b], axis), angle_memory[e, 1])
             scalar = prm[3] * (prm[4] + prm[5] * theta_a + prm[6] * theta_b)
             _apply_law(out, x, rotation, b if prm[7] > 0.5 else a, prm, scalar)
         elif kind == FORCE_DISTANCE_LAW:
@@ -169,7 +206,7 @@ def element_forces(t, x, rotation, v, omega, kinds, body_a, body_b, parameters, 
 
 @njit(cache=True)
 def applied_forces(t, x, rotation, v, omega, mass, gravity, fixed, kinds, body_a, body_b,
-                   parameters):
+                   parameters, angle_memory):
     """Gravity plus every force element at time ``t``: (nb, 6)."""
     nb = mass.shape[0]
     out = np.zeros((nb, 6))
@@ -177,7 +214,8 @@ def applied_forces(t, x, rotation, v, omega, mass, gravity, fixed, kinds, body_a
         if not fixed[b]:
             for i in range(3):
                 out[b, i] = mass[b] * gravity[i]
-    element_forces(t, x, rotation, v, omega, kinds, body_a, body_b, parameters, False, out)
+    element_forces(t, x, rotation, v, omega, kinds, body_a, body_b, parameters, angle_memory,
+                   False, out)
     for b in range(nb):
         if fixed[b]:
             out[b, :] = 0.0
@@ -186,7 +224,7 @@ def applied_forces(t, x, rotation, v, omega, mass, gravity, fixed, kinds, body_a
 
 @njit(cache=True)
 def spring_jacobians(t, x, p, v, omega, fixed, kinds, body_a, body_b, parameters,
-                     length_step):
+                     angle_memory, length_step):
     """Stiffness K = dF/dxi and damping C = dF/dnu of the spring elements, (6 nb, 6 nb).
 
     xi is the generalised displacement (world translation, body-axes rotation vector applied as
@@ -206,7 +244,8 @@ def spring_jacobians(t, x, p, v, omega, fixed, kinds, body_a, body_b, parameters
                 involved[body_b[e]] = True
     rotation = rotation_matrices(p)
     base = np.zeros((nb, 6))
-    element_forces(t, x, rotation, v, omega, kinds, body_a, body_b, parameters, True, base)
+    element_forces(t, x, rotation, v, omega, kinds, body_a, body_b, parameters, angle_memory,
+                   True, base)
     for b in range(nb):
         if fixed[b] or not involved[b]:
             continue
@@ -225,8 +264,8 @@ def spring_jacobians(t, x, p, v, omega, fixed, kinds, body_a, body_b, parameters
                     rv[k - 3] = sign * step
                     rs[b] = quat_to_matrix(quat_multiply(p[b], quat_exp(rv)))
                 target = plus if sign > 0 else minus
-                element_forces(t, xs, rs, v, omega, kinds, body_a, body_b, parameters, True,
-                               target)
+                element_forces(t, xs, rs, v, omega, kinds, body_a, body_b, parameters,
+                               angle_memory, True, target)
             for r in range(nb):
                 for i in range(6):
                     stiffness[6 * r + i, column] = (plus[r, i] - minus[r, i]) / (2.0 * step)
@@ -237,8 +276,8 @@ def spring_jacobians(t, x, p, v, omega, fixed, kinds, body_a, body_b, parameters
             else:
                 ws[b, k - 3] += 1.0
             bumped = np.zeros((nb, 6))
-            element_forces(t, x, rotation, vs, ws, kinds, body_a, body_b, parameters, True,
-                           bumped)
+            element_forces(t, x, rotation, vs, ws, kinds, body_a, body_b, parameters,
+                           angle_memory, True, bumped)
             for r in range(nb):
                 for i in range(6):
                     damping[6 * r + i, column] = bumped[r, i] - base[r, i]

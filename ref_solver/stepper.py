@@ -60,7 +60,13 @@ from .constraints import (
 )
 from .contact_problem import ContactProblem, SolverOptions
 from .fc3d_solve import solve_contact_problem
-from .forces import applied_forces, rotation_matrices, spring_jacobians
+from .forces import (
+    applied_forces,
+    no_angle_memory,
+    remember_angles,
+    rotation_matrices,
+    spring_jacobians,
+)
 from .gyroscopic import gyroscopic_update, integrate_orientations
 from .projection import solve_projection
 from .system import MultibodySystem, State
@@ -232,6 +238,8 @@ class MoreauJeanStepper:
         self.previous_impulse = np.zeros((npair, k, 3))
         self.previous_bilateral = np.zeros(system.bilateral_row_count)
         self._newton_first = False  # hybrid: the last problem needed Newton (see _solve)
+        # the angle laws' continuous angles at the last step (forces.remember_angles)
+        self.angle_memory = no_angle_memory(system.force_kind.shape[0])
         self.single_clusters = (np.arange(nb, dtype=np.int64),
                                 np.arange(6 * nb, dtype=np.int64),
                                 np.arange(0, 6 * nb + 1, 6, dtype=np.int64))
@@ -302,7 +310,11 @@ class MoreauJeanStepper:
         if not h > 0.0:
             raise ValueError(f"time_step must be > 0, got {time_step!r}")
         splits = self.settings.max_impact_splits if self.settings.localise_impacts else 0
-        return self._advance(state, h, splits)
+        result = self._advance(state, h, splits)
+        sys_ = self.system
+        remember_angles(rotation_matrices(result.state.p), sys_.force_kind, sys_.force_body_a,
+                        sys_.force_body_b, sys_.force_parameters, self.angle_memory)
+        return result
 
     def _advance(self, state: State, h: float, splits: int) -> StepResult:
         """One step of length h, localising at most ``splits`` impacts (module docstring)."""
@@ -386,14 +398,15 @@ class MoreauJeanStepper:
         t_theta = state.t + theta * h
         forces = applied_forces(t_theta, state.x, rotation, state.v, state.omega, sys_.mass,
                                 sys_.gravity, sys_.body_fixed, sys_.force_kind,
-                                sys_.force_body_a, sys_.force_body_b, sys_.force_parameters)
+                                sys_.force_body_a, sys_.force_body_b, sys_.force_parameters,
+                                self.angle_memory)
         rhs = h * forces.ravel()
         inverse = self.inverse_mass
         if sys_.has_springs:
             stiffness, damping = spring_jacobians(
                 t_theta, state.x, state.p, state.v, state.omega, sys_.body_fixed,
                 sys_.force_kind, sys_.force_body_a, sys_.force_body_b, sys_.force_parameters,
-                1e-6 * cfg.length_scale)
+                self.angle_memory, 1e-6 * cfg.length_scale)
             iteration = self.mass_matrix - h * theta * damping - h * h * theta * theta * stiffness
             rhs = rhs + h * h * theta * (stiffness @ nu.ravel())
             inverse = self._cluster_inverse(iteration)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from clearbench.adapters.reference_build import build_system, initial_state
-from clearbench.ref_solver.forces import applied_forces, rotation_matrices
+from clearbench.ref_solver.forces import applied_forces, no_angle_memory, rotation_matrices
 from clearbench.scenarios import c60_model as model
 from clearbench.scenarios.geometry import check_supported_pair, contacts_between
 from clearbench.scenarios.registry import get_scene, scene_names
@@ -195,7 +195,8 @@ def test_law_loads_are_the_source_plugin_laws(t):
     rotation = rotation_matrices(state.p)
     forces = applied_forces(t, state.x, rotation, state.v, state.omega, system.mass,
                             system.gravity, system.body_fixed, system.force_kind,
-                            system.force_body_a, system.force_body_b, system.force_parameters)
+                            system.force_body_a, system.force_body_b, system.force_parameters,
+                            no_angle_memory(system.force_kind.shape[0]))
     expected = source_loads(scene, positions, quaternions, t)
     for name, (force, moment) in expected.items():
         index = scene.body_index(name)

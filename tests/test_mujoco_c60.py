@@ -24,7 +24,7 @@ from clearbench.adapters.mujoco_settings import resolve_settings
 from clearbench.adapters.reference_build import build_system
 from clearbench.adapters.trajectory import RunStatus
 from clearbench.harness import metrics
-from clearbench.ref_solver.forces import element_forces
+from clearbench.ref_solver.forces import element_forces, no_angle_memory
 from clearbench.scenarios.quaternion import quat_from_axis_angle
 from clearbench.scenarios.registry import get_scene, scene_names
 from clearbench.scenarios.shapes import Bore
@@ -154,7 +154,8 @@ def test_law_loads_equal_the_reference_force_evaluation_at_the_same_state():
     zeros = np.zeros_like(x)
     # springs_only skips the time-switched moment; the C-60 has no other spring: only laws.
     element_forces(0.0, x, rotation, zeros, zeros, system.force_kind, system.force_body_a,
-                   system.force_body_b, system.force_parameters, True, expected)
+                   system.force_body_b, system.force_parameters,
+                   no_angle_memory(system.force_kind.shape[0]), True, expected)
     moment_world = np.einsum("bij,bj->bi", rotation, expected[:, 3:])
     scale = np.abs(expected).max()
     assert scale > 1.0  # the laws act (N, N mm): the comparison is not of zeros

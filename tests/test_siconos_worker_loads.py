@@ -23,7 +23,7 @@ from clearbench.adapters import siconos_engine
 from clearbench.adapters.base import RunSettings, Support
 from clearbench.adapters.reference_build import build_system
 from clearbench.adapters.trajectory import RunStatus
-from clearbench.ref_solver.forces import applied_forces, rotation_matrices
+from clearbench.ref_solver.forces import applied_forces, no_angle_memory, rotation_matrices
 from clearbench.scenarios.loads import AngleLawLoad, DistanceLawLoad, LoadApplication
 from clearbench.scenarios.quaternion import quat_normalize, quat_to_matrix
 from clearbench.scenarios.registry import get_scene, scene_names
@@ -107,7 +107,7 @@ def test_worker_loads_match_the_reference_forces_at_random_states(worker):
         reference = applied_forces(
             t, x, rotation_matrices(p), v, omega, system.mass, system.gravity,
             system.body_fixed, system.force_kind, system.force_body_a, system.force_body_b,
-            system.force_parameters)
+            system.force_parameters, no_angle_memory(system.force_kind.shape[0]))
         for b, body in enumerate(bodies):
             if body.fixed:
                 continue
