@@ -374,11 +374,11 @@ MODEL_NOTES = (
     "the handle turns freely (the source has no OFF stop) and brings its ON-stop face round "
     "behind the case's stop pins; without a depth that counted as an 8.5 mm penetration at "
     "15.2 ms and the projection tore the handle out of its bearing.",
-    "Angle laws take each body's absolute angle about the law's axis in (-pi, pi] (the source's "
-    "2 acos(q_w) in [0, 2 pi] likewise): a body turning through the cut makes the law's "
-    "moment jump by k 2 pi. `benchmarks/c60_body_angles.py TRAJECTORY.npz` prints each "
-    "body's angle and the largest body speed along a run (for a bench test that gives no "
-    "curve: its cache file in .cache/c60/).",
+    "Angle laws take each body's angle about the law's axis as the source's 2 acos(q_w) "
+    "does, but continuous: a body turning through the cut of the raw angle (pi) keeps its law "
+    "continuous (the source's would jump by k 2 pi; in the ON and trip runs no law body comes "
+    "near the cut). `benchmarks/c60_body_angles.py TRAJECTORY.npz` prints each body's raw "
+    "angle and the largest body speed along a run (the runs are cached in .cache/c60/).",
     "Bounded faces: TRIP_1 and C3 ON 1, 2 have their nearest point beyond the face (no "
     "contact candidate; OpenCASCADE measures to the face's edge, 0.86 and 3.8 mm in the ON "
     "pose). Every other ON-pose gap agrees with OpenCASCADE within the CAD's B-spline residual "

@@ -279,8 +279,10 @@ class AngleLawLoad(Load):
     ``s = stiffness * (offset + sum_i angle_coefficients[i] * theta(bodies[i]))`` [F L], where
     theta(b) is the ABSOLUTE rotation of body b about the world ``axis``: the twist angle
     2 atan2(q . axis, q_w) of its orientation quaternion q (q_w >= 0), i.e. its rotation from
-    the body frame's reference orientation (1, 0, 0, 0). The offset carries the law's reference
-    (a rest angle, a preload). Each application turns ``s`` into a force (``coefficient * s /
+    the body frame's reference orientation (1, 0, 0, 0), in (-pi, pi] at t = 0 and continuous
+    after (engines add the whole turns a body makes: a body turning through pi does not make
+    the law jump by 2 pi). The offset carries the law's reference (a rest angle, a preload).
+    Each application turns ``s`` into a force (``coefficient * s /
     lever``) or a moment (``coefficient * s``); see :class:`LoadApplication`.
     """
 
