@@ -35,25 +35,25 @@ def _sources_fingerprint() -> str:
     return digest.hexdigest()[:16]
 
 
-def source_digest() -> str:
-    """sha256 of the package's sources (relative path and content of every module) [hex, 16
-    chars], computed once per process. Part of every stored run's key, so that a result
-    computed by other code is never served as this code's (``clearbench run`` reran nothing
-    after an adapter fix before); the same on every clone of the same revision."""
-    global _SOURCE_DIGEST
-    if _SOURCE_DIGEST is None:
+def source_digest(subpackages: tuple[str, ...] = _SUBPACKAGES) -> str:
+    """sha256 of the sources of ``subpackages`` (relative path and content of every module)
+    [hex, 16 chars], computed once per process and selection. Part of every stored run's key
+    (all subpackages), so that a result computed by other code is never served as this code's
+    (``clearbench run`` reran nothing after an adapter fix before); the same on every clone of
+    the same revision. The C-60 validation cache keys its runs on the physics subpackages."""
+    if subpackages not in _SOURCE_DIGESTS:
         digest = hashlib.sha256(__version__.encode())
-        for name in _SUBPACKAGES:
+        for name in subpackages:
             spec = importlib.util.find_spec(name)
             for location in (spec.submodule_search_locations or []) if spec else []:
                 for path in sorted(Path(location).glob("*.py")):
                     digest.update(f"{name}/{path.name}\n".encode())
                     digest.update(path.read_bytes())
-        _SOURCE_DIGEST = digest.hexdigest()[:16]
-    return _SOURCE_DIGEST
+        _SOURCE_DIGESTS[subpackages] = digest.hexdigest()[:16]
+    return _SOURCE_DIGESTS[subpackages]
 
 
-_SOURCE_DIGEST: str | None = None
+_SOURCE_DIGESTS: dict[tuple[str, ...], str] = {}
 
 #: Cache directories of earlier source states kept besides the current one.
 _KEEP_CACHES = 4

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+import clearbench
 from clearbench.adapters.base import RunSettings
 from clearbench.adapters.reference import create
 from clearbench.adapters.trajectory import Trajectory
@@ -57,12 +58,16 @@ class Run:
 
 def run_scene(key: str, name: str, parameters: dict, cache: Path | None, preset: str = "default",
               record_every: int = 10) -> Run:
-    """Run a registered scene with the reference engine, or read it back from ``cache``."""
+    """Run a registered scene with the reference engine, or read it back from ``cache``: a
+    cached run is reused when its scene, preset and physics code (the sources of the scenes,
+    the solver and the adapters, :data:`PHYSICS_CODE`) are this run's."""
     scene = get_scene(name, **parameters)
+    code = clearbench.source_digest(PHYSICS_CODE)
     path = cache / f"{key}.npz" if cache is not None else None
     if path is not None and path.exists():
         trajectory = Trajectory.load(path)
-        if trajectory.scene_hash == scene.content_hash and trajectory.preset == preset:
+        if (trajectory.scene_hash == scene.content_hash and trajectory.preset == preset
+                and trajectory.metadata.get("physics_code") == code):
             logger.info("%s: read from %s", key, path)
             return Run(key, scene, trajectory)
     logger.info("%s: running %s %s (%s steps)", key, name, parameters,
@@ -70,11 +75,15 @@ def run_scene(key: str, name: str, parameters: dict, cache: Path | None, preset:
     tick = time.perf_counter()
     trajectory = create(preset).run(scene, RunSettings(record_every=record_every))
     logger.info("%s: %.0f s", key, time.perf_counter() - tick)
+    trajectory.metadata["physics_code"] = code
     if path is not None:
         path.parent.mkdir(parents=True, exist_ok=True)
         trajectory.save(path)
     return Run(key, scene, trajectory)
 
+
+#: The subpackages whose sources decide a cached run's trajectory.
+PHYSICS_CODE = ("clearbench.scenarios", "clearbench.ref_solver", "clearbench.adapters")
 
 #: Largest contact penetration the C-60 runs may show [mm] (the issue's limit); a run beyond
 #: it is a finding of the report.

@@ -31,7 +31,7 @@ def register(subparsers) -> None:
         description="Run (or read from the cache) the C-60 scenes, print the validation "
         "table, write it as Markdown and the force-displacement figures as PNG. A full run "
         "takes tens of minutes of stepping on one core; cached runs are reused when the "
-        "scene is unchanged.",
+        "scene, the preset and the physics code (scenes, solver, adapters) are unchanged.",
     )
     validate.add_argument("--out", type=Path, default=DEFAULT_REPORT,
                           help=f"Markdown report (default {DEFAULT_REPORT})")

@@ -120,7 +120,7 @@ def test_run_key_changes_with_the_code(monkeypatch):
 
     base = fake_spec().key
     assert clearbench.source_digest() == clearbench.source_digest()
-    monkeypatch.setattr(clearbench, "_SOURCE_DIGEST", "0" * 16)
+    monkeypatch.setitem(clearbench._SOURCE_DIGESTS, clearbench._SUBPACKAGES, "0" * 16)
     assert fake_spec().key != base
 
 
