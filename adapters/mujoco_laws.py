@@ -73,12 +73,19 @@ class LawForces:
         if self.angle_memory.shape != (self.kinds.shape[0], 2):
             self.angle_memory = no_angle_memory(self.kinds.shape[0])
 
+    def _pose(self, data) -> tuple[np.ndarray, np.ndarray]:
+        """Centres of mass (nb, 3) and rotations (nb, 3, 3) of the scene's bodies in ``data``."""
+        ids = self.body_ids
+        return (np.ascontiguousarray(data.xipos[ids]),
+                np.ascontiguousarray(data.xmat[ids].reshape(-1, 3, 3)))
+
     def wrenches(self, data, time: float = 0.0) -> np.ndarray:
         """(nb, 6) force [F] and moment about the centre of mass [F L], both in world axes, of
         every body at the configuration in ``data`` (xipos and xmat must be current)."""
+        return self._wrenches(*self._pose(data), time)
+
+    def _wrenches(self, x: np.ndarray, rotation: np.ndarray, time: float) -> np.ndarray:
         ids = self.body_ids
-        x = np.ascontiguousarray(data.xipos[ids])
-        rotation = np.ascontiguousarray(data.xmat[ids].reshape(-1, 3, 3))
         zeros = np.zeros_like(x)  # the laws read no velocity
         out = np.zeros((len(ids), 6))
         element_forces(time, x, rotation, zeros, zeros, self.kinds, self.body_a, self.body_b,
@@ -89,9 +96,8 @@ class LawForces:
 
     def apply(self, data) -> None:
         """Add the law wrenches to ``data.xfrc_applied`` (applied at each centre of mass)."""
-        wrench = self.wrenches(data, float(data.time))
-        np.add.at(data.xfrc_applied, self.body_ids, wrench)
-        rotation = np.ascontiguousarray(data.xmat[self.body_ids].reshape(-1, 3, 3))
+        x, rotation = self._pose(data)
+        np.add.at(data.xfrc_applied, self.body_ids, self._wrenches(x, rotation, float(data.time)))
         remember_angles(rotation, self.kinds, self.body_a, self.body_b, self.parameters,
                         self.angle_memory)
 

@@ -23,15 +23,21 @@ _SUBPACKAGES = ("clearbench.scenarios", "clearbench.ref_solver", "clearbench.ada
                 "clearbench.harness")
 
 
-def _sources_fingerprint() -> str:
-    """Digest of the path, size and modification time of every source file [hex, 16 chars]."""
-    digest = hashlib.sha1(__version__.encode())
-    for name in _SUBPACKAGES:
+def _source_files(subpackages: tuple[str, ...]):
+    """(subpackage name, path) of every module of ``subpackages``, in a fixed order."""
+    for name in subpackages:
         spec = importlib.util.find_spec(name)
         for location in (spec.submodule_search_locations or []) if spec else []:
             for path in sorted(Path(location).glob("*.py")):
-                stat = path.stat()
-                digest.update(f"{path}:{stat.st_size}:{stat.st_mtime_ns}\n".encode())
+                yield name, path
+
+
+def _sources_fingerprint() -> str:
+    """Digest of the path, size and modification time of every source file [hex, 16 chars]."""
+    digest = hashlib.sha1(__version__.encode())
+    for _, path in _source_files(_SUBPACKAGES):
+        stat = path.stat()
+        digest.update(f"{path}:{stat.st_size}:{stat.st_mtime_ns}\n".encode())
     return digest.hexdigest()[:16]
 
 
@@ -43,12 +49,9 @@ def source_digest(subpackages: tuple[str, ...] = _SUBPACKAGES) -> str:
     the same revision. The C-60 validation cache keys its runs on the physics subpackages."""
     if subpackages not in _SOURCE_DIGESTS:
         digest = hashlib.sha256(__version__.encode())
-        for name in subpackages:
-            spec = importlib.util.find_spec(name)
-            for location in (spec.submodule_search_locations or []) if spec else []:
-                for path in sorted(Path(location).glob("*.py")):
-                    digest.update(f"{name}/{path.name}\n".encode())
-                    digest.update(path.read_bytes())
+        for name, path in _source_files(subpackages):
+            digest.update(f"{name}/{path.name}\n".encode())
+            digest.update(path.read_bytes())
         _SOURCE_DIGESTS[subpackages] = digest.hexdigest()[:16]
     return _SOURCE_DIGESTS[subpackages]
 

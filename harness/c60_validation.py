@@ -8,6 +8,7 @@ trajectory file keyed by the scene's content hash), computes the figures and ret
 
 from __future__ import annotations
 
+import functools
 import logging
 import math
 import time
@@ -50,8 +51,9 @@ class Run:
     def unconverged(self) -> list:
         return list(self.trajectory.metadata.get("unconverged_steps", []))
 
-    @property
+    @functools.cached_property
     def penetration(self) -> float:
+        """Largest contact penetration over the recorded states [mm] (computed once)."""
         depth = metrics.penetration(self.scene, self.trajectory)
         return float(depth.max()) if depth.size else 0.0
 

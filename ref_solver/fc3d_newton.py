@@ -24,7 +24,6 @@ from numba import njit
 
 from .contact_problem import (
     ContactProblem,
-    Normalisation,
     SolverOptions,
     SolverResult,
     SolverStatus,
@@ -202,14 +201,13 @@ def solve_newton(
         _, rel_q, rel_max = residual_both(r_, u_, q, mu, nb)
         return u_, rel_q, rel_max, (rel_max if use_max else rel_q)
 
-    normalisation = Normalisation.MAX if use_max else Normalisation.Q
     u, residual_q, residual_max, residual = measure(r)
     while True:
         if residual <= options.tolerance:
             status = SolverStatus.CONVERGED
             break
         if options.roundoff_floor and math.isfinite(residual):
-            floor = roundoff_floor(abs_operator_of(problem), r, u, q, mu, normalisation)
+            floor = roundoff_floor(abs_operator_of(problem), r, u, q, mu, use_max)
             if residual <= floor:
                 status = SolverStatus.CONVERGED
                 message = floor_message(residual, floor, options.tolerance)

@@ -19,7 +19,6 @@ from numba import njit
 
 from .contact_problem import (
     ContactProblem,
-    Normalisation,
     SolverOptions,
     SolverResult,
     SolverStatus,
@@ -126,6 +125,8 @@ def nsgs_kernel(
     norm_u = 0.0
     failures = 0
     n_checks = 0
+    status = 1  # max iterations, unless the loop ends otherwise
+    sweeps = max_sweeps
     for sweep in range(max_sweeps):
         # bilateral rows, exact: W_bb r_b = -(q_b + W_bc r_c)
         if n_bilateral > 0:
@@ -170,16 +171,14 @@ def nsgs_kernel(
             history[n_checks] = residual
             n_checks += 1
             if residual <= tolerance:
-                return (0, sweep + 1, normalised(abs_residual, norm_q, norm_r, norm_u, False),
-                        normalised(abs_residual, norm_q, norm_r, norm_u, True), failures,
-                        n_checks)
+                status, sweeps = 0, sweep + 1
+                break
             if 0 < stall_window < n_checks and n_checks >= stall_after and hopeless(
                     history[n_checks - 1 - stall_window], residual,
                     stall_window * check_interval, tolerance, max_sweeps - sweep - 1):
-                return (2, sweep + 1, normalised(abs_residual, norm_q, norm_r, norm_u, False),
-                        normalised(abs_residual, norm_q, norm_r, norm_u, True), failures,
-                        n_checks)
-    return (1, max_sweeps, normalised(abs_residual, norm_q, norm_r, norm_u, False),
+                status, sweeps = 2, sweep + 1
+                break
+    return (status, sweeps, normalised(abs_residual, norm_q, norm_r, norm_u, False),
             normalised(abs_residual, norm_q, norm_r, norm_u, True), failures, n_checks)
 
 
@@ -222,8 +221,7 @@ def solve_nsgs(
     status = _STATUS_CODES[code]
     residual = residual_max if use_max else residual_q
     if status in (SolverStatus.MAX_ITERATIONS, SolverStatus.STALLED) and options.roundoff_floor:
-        floor = roundoff_floor(abs_operator_of(problem), r, u, problem.q, problem.mu,
-                               Normalisation.MAX if use_max else Normalisation.Q)
+        floor = roundoff_floor(abs_operator_of(problem), r, u, problem.q, problem.mu, use_max)
         if residual <= floor:
             return SolverResult(r, u, sweeps, residual, residual_q, residual_max, True,
                                 SolverStatus.CONVERGED, method,

@@ -81,7 +81,7 @@ def normalised(abs_residual: float, norm_q: float, norm_r: float, norm_u: float,
 
 
 def roundoff_floor(W_abs, r: np.ndarray, u: np.ndarray, q: np.ndarray, mu: np.ndarray,
-                   normalisation: Normalisation) -> float:
+                   use_max: bool) -> float:
     """Bound on the rounding error of the normalised residual evaluated at ``r``.
 
     u = W r + q computed in floating point is off by at most gamma_(m+1) (|W| |r| + |q|) per
@@ -98,8 +98,8 @@ def roundoff_floor(W_abs, r: np.ndarray, u: np.ndarray, q: np.ndarray, mu: np.nd
     r, u, q : ndarray, shape (m,)
         Impulses, their velocities W r + q, the free velocities.
     mu : ndarray, shape (nc,)
-    normalisation : Normalisation
-        That of the residual it is compared with.
+    use_max : bool
+        The normalisation of the residual it is compared with (as :func:`normalised`).
     """
     m = q.size
     eps = np.finfo(np.float64).eps
@@ -109,8 +109,7 @@ def roundoff_floor(W_abs, r: np.ndarray, u: np.ndarray, q: np.ndarray, mu: np.nd
     norm_r = math.sqrt(r.dot(r))
     bound = amplification * gamma * math.sqrt(velocity_error.dot(velocity_error)) \
         + 2.0 * eps * norm_r
-    return normalised(bound, math.sqrt(q.dot(q)), norm_r, math.sqrt(u.dot(u)),
-                      normalisation is Normalisation.MAX)
+    return normalised(bound, math.sqrt(q.dot(q)), norm_r, math.sqrt(u.dot(u)), use_max)
 
 
 @njit(cache=True)
