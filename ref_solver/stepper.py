@@ -513,10 +513,9 @@ class MoreauJeanStepper:
         Newton from the warm start is tried first. Every attempt runs to its cap: stopping
         the attempts early when their rate of progress could not reach the tolerance
         (``SolverOptions.stall_window``) was measured on c60-trip and dropped: 250 unconverged
-        steps instead of 5, and slower (80.2 s against 73.7 s of stepping), since a step whose
-        NSGS is cut short goes through the whole chain. Redundant
-        contacts (the two rings of a bearing) make W singular: NSGS crawls there and Newton can
-        stall from a poor start, while another start converges in a few iterations.
+        steps instead of 5, since a step whose NSGS is cut short goes through the whole chain.
+        Redundant contacts (the two rings of a bearing) make W singular: NSGS crawls there and
+        Newton can stall from a poor start, while another start converges in a few iterations.
         """
         cfg = self.settings
         if cfg.method != "hybrid":
