@@ -11,9 +11,8 @@ import enum
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 
+from clearbench.adapters.trajectory import RunStatus, Trajectory
 from clearbench.scenarios.scene import Scene
-
-from .trajectory import RunStatus, Trajectory
 
 
 class Support(enum.Enum):

@@ -16,7 +16,7 @@ import time
 
 import numpy as np
 
-from clearbench.harness.fclib_io import (
+from clearbench.harness.fclib.problems import (
     UnsupportedProblemError,
     load_problem,
     shipped_problem_files,

@@ -15,8 +15,8 @@ import time
 import numpy as np
 from numba import njit
 
+from clearbench.kernels.quaternion import quat_from_axis_angle, quat_to_matrix
 from clearbench.scenarios import geometry as G
-from clearbench.scenarios.quaternion import quat_from_axis_angle, quat_to_matrix
 
 
 @njit  # not cached: numba cache keys ignore edits of the kernels it calls

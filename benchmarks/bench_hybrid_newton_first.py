@@ -15,9 +15,9 @@ import sys
 import numpy as np
 
 from clearbench.adapters.base import RunSettings
-from clearbench.adapters.reference import create
+from clearbench.adapters.reference.engine import create
 from clearbench.ref_solver import stepper
-from clearbench.scenarios.registry import get_scene
+from clearbench.scenarios.library import get_scene
 
 
 def _run(horizon: float, newton_first: bool) -> None:

@@ -13,9 +13,9 @@ from __future__ import annotations
 import sys
 
 from clearbench.adapters.base import RunSettings
-from clearbench.adapters.reference import create
-from clearbench.harness.expectations import evaluate
-from clearbench.scenarios.registry import get_scene
+from clearbench.adapters.reference.engine import create
+from clearbench.harness.measure.expectation_figures import evaluate
+from clearbench.scenarios.library import get_scene
 
 
 def main(names: list[str]) -> None:

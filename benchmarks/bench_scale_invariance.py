@@ -14,8 +14,8 @@ import dataclasses
 import numpy as np
 
 from clearbench.adapters.base import RunSettings
-from clearbench.adapters.reference import create
-from clearbench.scenarios.registry import get_scene
+from clearbench.adapters.reference.engine import create
+from clearbench.scenarios.library import get_scene
 from clearbench.scenarios.units import MM_G_MS
 
 HORIZON = 0.5  # [s]

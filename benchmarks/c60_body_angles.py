@@ -15,8 +15,8 @@ import sys
 import numpy as np
 
 from clearbench.adapters.trajectory import Trajectory
+from clearbench.kernels.quaternion import quat_to_matrix
 from clearbench.ref_solver.forces import twist_angle
-from clearbench.scenarios.quaternion import quat_to_matrix
 
 Z = np.array([0.0, 0.0, 1.0])
 

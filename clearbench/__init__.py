@@ -1,9 +1,11 @@
 """clearbench: a cross-validation harness for rigid-body contact simulators.
 
 The sub-packages live in top-level folders of the repository and are installed under this
-namespace: ``clearbench.scenarios`` (engine-neutral scenes, geometry, analytic references),
+namespace: ``clearbench.kernels`` (the pure-math floor: quaternions, frames, gap kernels,
+time profiles),
+``clearbench.scenarios`` (engine-neutral scenes, geometry, analytic references),
 ``clearbench.ref_solver`` (our nonsmooth Moreau--Jean solver), ``clearbench.adapters`` (one
-module per engine) and ``clearbench.harness`` (runner, metrics, store, report, CLI).
+subpackage per engine) and ``clearbench.harness`` (runner, metrics, store, report, CLI).
 
 Importing the package points numba's on-disk cache (``NUMBA_CACHE_DIR``, unless the user set
 it) at a directory named after the state of the package's sources. numba keys a cached kernel
@@ -19,23 +21,25 @@ from pathlib import Path
 
 __version__ = "0.1.0"
 
-_SUBPACKAGES = ("clearbench.scenarios", "clearbench.ref_solver", "clearbench.adapters",
-                "clearbench.harness")
+_SUBPACKAGES = ("clearbench.kernels", "clearbench.scenarios", "clearbench.ref_solver",
+                "clearbench.adapters", "clearbench.harness")
 
 
 def _source_files(subpackages: tuple[str, ...]):
-    """(subpackage name, path) of every module of ``subpackages``, in a fixed order."""
+    """(subpackage name, path relative to the subpackage, path) of every module of
+    ``subpackages`` and of their own subpackages, in a fixed order."""
     for name in subpackages:
         spec = importlib.util.find_spec(name)
         for location in (spec.submodule_search_locations or []) if spec else []:
-            for path in sorted(Path(location).glob("*.py")):
-                yield name, path
+            root = Path(location)
+            for path in sorted(root.rglob("*.py")):
+                yield name, path.relative_to(root).as_posix(), path
 
 
 def _sources_fingerprint() -> str:
     """Digest of the path, size and modification time of every source file [hex, 16 chars]."""
     digest = hashlib.sha1(__version__.encode())
-    for _, path in _source_files(_SUBPACKAGES):
+    for _, _, path in _source_files(_SUBPACKAGES):
         stat = path.stat()
         digest.update(f"{path}:{stat.st_size}:{stat.st_mtime_ns}\n".encode())
     return digest.hexdigest()[:16]
@@ -49,8 +53,8 @@ def source_digest(subpackages: tuple[str, ...] = _SUBPACKAGES) -> str:
     the same revision. The C-60 validation cache keys its runs on the physics subpackages."""
     if subpackages not in _SOURCE_DIGESTS:
         digest = hashlib.sha256(__version__.encode())
-        for name, path in _source_files(subpackages):
-            digest.update(f"{name}/{path.name}\n".encode())
+        for name, relative, path in _source_files(subpackages):
+            digest.update(f"{name}/{relative}\n".encode())
             digest.update(path.read_bytes())
         _SOURCE_DIGESTS[subpackages] = digest.hexdigest()[:16]
     return _SOURCE_DIGESTS[subpackages]

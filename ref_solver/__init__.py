@@ -5,16 +5,16 @@ One-step contact solvers (public API)::
     from clearbench.ref_solver import ContactProblem, SolverOptions, solve_contact_problem
 """
 
-from .contact_problem import (
+from clearbench.ref_solver.contact_problem import (
     ContactProblem,
     Normalisation,
     SolverOptions,
     SolverResult,
     SolverStatus,
 )
-from .fc3d_residual import natural_map_residual
-from .fc3d_solve import solve_contact_problem
-from .mlcp import MLCPResult, solve_mlcp
+from clearbench.ref_solver.fc3d_residual import natural_map_residual
+from clearbench.ref_solver.fc3d_solve import solve_contact_problem
+from clearbench.ref_solver.mlcp import MLCPResult, solve_mlcp
 
 __all__ = [
     "ContactProblem",

@@ -16,11 +16,10 @@ import math
 import numpy as np
 from numba import njit
 
+from clearbench.kernels.quaternion import quat_conjugate, quat_multiply
+from clearbench.ref_solver.linalg3 import cross, dot, mat_mat, mat_t_vec, mat_vec
+from clearbench.ref_solver.system import JOINT_FIXED, JOINT_PRISMATIC, JOINT_REVOLUTE, JOINT_ROWS
 from clearbench.scenarios.geometry import MAX_CONTACTS_PER_PAIR, pair_contacts
-from clearbench.scenarios.quaternion import quat_conjugate, quat_multiply
-
-from .linalg3 import cross, dot, mat_mat, mat_t_vec, mat_vec
-from .system import JOINT_FIXED, JOINT_PRISMATIC, JOINT_REVOLUTE, JOINT_ROWS
 
 
 @njit(cache=True, inline="always")

@@ -30,7 +30,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .fc3d_residual import contact_natural_map, project_on_cone
+from clearbench.ref_solver.fc3d_residual import contact_natural_map, project_on_cone
 
 #: Local solver kinds (integers so that numba kernels can branch on them).
 AC = 0

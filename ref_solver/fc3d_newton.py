@@ -22,15 +22,15 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numba import njit
 
-from .contact_problem import (
+from clearbench.ref_solver.contact_problem import (
     ContactProblem,
     SolverOptions,
     SolverResult,
     SolverStatus,
 )
-from .fc3d_local import LOCAL_KIND, alart_curnier
-from .fc3d_nsgs import bilateral_operator_of, diagonal_blocks, nsgs_kernel
-from .fc3d_residual import (
+from clearbench.ref_solver.fc3d_local import LOCAL_KIND, alart_curnier
+from clearbench.ref_solver.fc3d_nsgs import bilateral_operator_of, diagonal_blocks, nsgs_kernel
+from clearbench.ref_solver.fc3d_residual import (
     abs_operator_of,
     floor_message,
     hopeless,

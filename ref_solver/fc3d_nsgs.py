@@ -17,14 +17,14 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
-from .contact_problem import (
+from clearbench.ref_solver.contact_problem import (
     ContactProblem,
     SolverOptions,
     SolverResult,
     SolverStatus,
 )
-from .fc3d_local import LOCAL_FAILED, LOCAL_KIND, N_MAT, N_VEC, solve_local
-from .fc3d_residual import (
+from clearbench.ref_solver.fc3d_local import LOCAL_FAILED, LOCAL_KIND, N_MAT, N_VEC, solve_local
+from clearbench.ref_solver.fc3d_residual import (
     abs_operator_of,
     csr_matvec_plus,
     floor_message,

@@ -17,7 +17,7 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
-from .contact_problem import Normalisation
+from clearbench.ref_solver.contact_problem import Normalisation
 
 
 @njit(cache=True, inline="always")

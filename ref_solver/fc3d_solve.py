@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .contact_problem import ContactProblem, SolverOptions, SolverResult
-from .fc3d_newton import solve_newton
-from .fc3d_nsgs import solve_nsgs
+from clearbench.ref_solver.contact_problem import ContactProblem, SolverOptions, SolverResult
+from clearbench.ref_solver.fc3d_newton import solve_newton
+from clearbench.ref_solver.fc3d_nsgs import solve_nsgs
 
 
 def solve_contact_problem(

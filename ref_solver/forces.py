@@ -34,10 +34,9 @@ import math
 import numpy as np
 from numba import njit
 
-from clearbench.scenarios.quaternion import quat_exp, quat_multiply, quat_to_matrix
-
-from .linalg3 import cross, dot, mat_t_vec, mat_vec
-from .system import (
+from clearbench.kernels.quaternion import quat_exp, quat_multiply, quat_to_matrix
+from clearbench.ref_solver.linalg3 import cross, dot, mat_t_vec, mat_vec
+from clearbench.ref_solver.system import (
     CONFIGURATION_FORCES,
     FORCE_ANGLE_LAW,
     FORCE_DISTANCE_LAW,

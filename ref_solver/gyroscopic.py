@@ -16,9 +16,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from clearbench.scenarios.quaternion import quat_exp, quat_integrate, quat_rotate
-
-from .linalg3 import mat_vec
+from clearbench.kernels.quaternion import quat_exp, quat_integrate, quat_rotate
+from clearbench.ref_solver.linalg3 import mat_vec
 
 
 @njit(cache=True)

@@ -20,9 +20,9 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
-from .contact_problem import Normalisation, SolverStatus
-from .fc3d_nsgs import bilateral_solve_operator
-from .fc3d_residual import normalised
+from clearbench.ref_solver.contact_problem import Normalisation, SolverStatus
+from clearbench.ref_solver.fc3d_nsgs import bilateral_solve_operator
+from clearbench.ref_solver.fc3d_residual import normalised
 
 
 @dataclass(frozen=True, eq=False)

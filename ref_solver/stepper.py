@@ -49,27 +49,26 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from clearbench.scenarios.geometry import MAX_CONTACTS_PER_PAIR
-
-from .constraints import (
+from clearbench.ref_solver.constraints import (
     bilateral_rows,
     contact_candidates,
     contact_rows,
     delassus,
     row_values,
 )
-from .contact_problem import ContactProblem, SolverOptions
-from .fc3d_solve import solve_contact_problem
-from .forces import (
+from clearbench.ref_solver.contact_problem import ContactProblem, SolverOptions
+from clearbench.ref_solver.fc3d_solve import solve_contact_problem
+from clearbench.ref_solver.forces import (
     applied_forces,
     no_angle_memory,
     remember_angles,
     rotation_matrices,
     spring_jacobians,
 )
-from .gyroscopic import gyroscopic_update, integrate_orientations
-from .projection import solve_projection
-from .system import MultibodySystem, State
+from clearbench.ref_solver.gyroscopic import gyroscopic_update, integrate_orientations
+from clearbench.ref_solver.projection import solve_projection
+from clearbench.ref_solver.system import MultibodySystem, State
+from clearbench.scenarios.geometry import MAX_CONTACTS_PER_PAIR
 
 #: Halvings of a projection correction that does not reduce the largest violation before the
 #: projection gives up (a correction scaled by 2^-8 that still does not help is not a descent).

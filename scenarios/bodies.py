@@ -5,9 +5,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from enum import Enum
 
-from .element import Element
-from .shapes import IDENTITY_QUATERNION, ORIGIN, Shape
-from .validation import (
+from clearbench.scenarios.element import Element
+from clearbench.scenarios.shapes import IDENTITY_QUATERNION, ORIGIN, Shape
+from clearbench.scenarios.validation import (
     ANGULAR_VELOCITY,
     INERTIA,
     LENGTH,

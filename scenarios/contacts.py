@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from .element import Element
-from .validation import (
+from clearbench.scenarios.element import Element
+from clearbench.scenarios.validation import (
     LENGTH,
     SceneError,
     check_finite,

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from .element import Element
-from .time_profiles import check_profile, evaluate_profile
-from .validation import (
+from clearbench.scenarios.element import Element
+from clearbench.scenarios.time_profiles import check_profile, evaluate_profile
+from clearbench.scenarios.validation import (
     ANGULAR_VELOCITY,
     DIMENSIONLESS,
     LENGTH,
@@ -91,7 +91,7 @@ class Driver(Element):
             return evaluate_profile(self.times, self.values, t)
         import numpy as np
 
-        from .time_profiles import integrate_profile
+        from clearbench.scenarios.time_profiles import integrate_profile
 
         if np.ndim(t) == 0:
             return integrate_profile(self.times, self.values, 0.0, float(t))

@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar
 
-from .validation import SceneError, check_name
+from clearbench.scenarios.validation import SceneError, check_name
 
 
 @dataclass(frozen=True)

@@ -10,8 +10,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from types import MappingProxyType
 
-from .element import Element
-from .validation import (
+from clearbench.scenarios.element import Element
+from clearbench.scenarios.validation import (
     ACCELERATION,
     ANGULAR_VELOCITY,
     DIMENSIONLESS,

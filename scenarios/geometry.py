@@ -20,7 +20,7 @@ Conventions (kept exactly by every pair)
 - Contact frame: rows ``(n, t1, t2)``, right-handed orthonormal (``t1 x t2 = n``), a function
   of ``n`` alone (:func:`contact_frame`). It is smooth everywhere except at the single normal
   direction :data:`FRAME_SINGULAR_DIRECTION` = -(2, 3, 6)/7, where it is still defined and
-  orthonormal (see :mod:`clearbench.scenarios.geometry_frames`).
+  orthonormal (see :mod:`clearbench.kernels.frames`).
 - Offsets: the scene's contact offset is NOT applied here; callers subtract it from the gap.
 - Candidates: pairs with several candidate points (box corners, cylinder rims) return all of
   them with their gaps, including separated ones; the caller keeps those below its activation
@@ -127,7 +127,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .geometry_frames import (
+from clearbench.kernels.frames import (
     FRAME_POLE,
     FRAME_SINGULAR_DIRECTION,
     contact_frame,
@@ -135,7 +135,7 @@ from .geometry_frames import (
     frame_tangent,
     write_contact_frame,
 )
-from .geometry_pairs import (
+from clearbench.kernels.gaps import (
     ARC,
     BORE,
     BOX,
@@ -152,10 +152,10 @@ from .geometry_pairs import (
     SUPPORTED,
     pair_contacts,
 )
-from .quaternion import quat_multiply, quat_normalize, quat_to_matrix
+from clearbench.kernels.quaternion import quat_multiply, quat_normalize, quat_to_matrix
 
 if TYPE_CHECKING:  # the kernels and this module never need the scene dataclasses at run time
-    from .shapes import Shape
+    from clearbench.scenarios.shapes import Shape
 
 __all__ = [
     "ARC",

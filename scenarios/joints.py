@@ -19,10 +19,10 @@ from typing import ClassVar
 
 import numpy as np
 
-from .contacts import ContactPair
-from .element import Element
-from .shapes import Arc, Circle, Cylinder, Plane, Shape
-from .validation import (
+from clearbench.scenarios.contacts import ContactPair
+from clearbench.scenarios.element import Element
+from clearbench.scenarios.shapes import Arc, Circle, Cylinder, Plane, Shape
+from clearbench.scenarios.validation import (
     LENGTH,
     SceneError,
     check_finite_vector,

@@ -22,9 +22,9 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
-from .element import Element
-from .joints import check_unit_axis
-from .validation import (
+from clearbench.scenarios.element import Element
+from clearbench.scenarios.joints import check_unit_axis
+from clearbench.scenarios.validation import (
     FORCE,
     LENGTH,
     LINEAR_DAMPING,

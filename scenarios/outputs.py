@@ -5,9 +5,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import ClassVar
 
-from .element import Element
-from .joints import check_unit_axis
-from .validation import (
+from clearbench.scenarios.element import Element
+from clearbench.scenarios.joints import check_unit_axis
+from clearbench.scenarios.validation import (
     DIMENSIONLESS,
     FORCE,
     LENGTH,

@@ -1,4 +1,5 @@
-"""The tagged scene registry: a plain dict from name to entry, filled by the library modules.
+"""The tagged scene registry: a plain dict from name to entry, filled by the library modules
+(:mod:`clearbench.scenarios.library`, which also looks scenes up).
 
 A scene is registered by a factory that builds it (keyword parameters allowed, e.g. a clearance
 for ladders), with tags the CLI, CI subsets and tests select by.
@@ -9,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
-from .scene import Scene
+from clearbench.scenarios.scene import Scene
 
 
 @dataclass(frozen=True)
@@ -44,28 +45,3 @@ def register(name: str, tags: Iterable[str], summary: str, **fixed_parameters):
         return factory
 
     return decorator
-
-
-def _load_library() -> None:
-    # Importing the library modules fills SCENES (kept here so that importing the registry is
-    # enough for every caller).
-    from . import library_basic, library_c60, library_mechanisms, library_stiff  # noqa: F401
-
-
-def scene_names(tag: str | None = None) -> list[str]:
-    """Registered names, in registration order, optionally only those with ``tag``."""
-    _load_library()
-    return [name for name, entry in SCENES.items() if tag is None or tag in entry.tags]
-
-
-def get_entry(name: str) -> SceneEntry:
-    """The entry called ``name``; KeyError listing the known names otherwise."""
-    _load_library()
-    if name not in SCENES:
-        raise KeyError(f"unknown scene {name!r}; known scenes: {', '.join(SCENES)}")
-    return SCENES[name]
-
-
-def get_scene(name: str, **parameters) -> Scene:
-    """Build the registered scene ``name``."""
-    return get_entry(name).build(**parameters)

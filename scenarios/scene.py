@@ -15,15 +15,15 @@ import json
 from dataclasses import dataclass, field
 from functools import cached_property
 
-from .bodies import Body, Motion
-from .contacts import ContactPair
-from .drivers import Driver
-from .expectations import Expectation
-from .joints import ClearanceRevoluteJoint, Joint
-from .loads import Load, Moment, PointForce
-from .outputs import ContactForce, Output
-from .units import UnitSystem
-from .validation import (
+from clearbench.scenarios.bodies import Body, Motion
+from clearbench.scenarios.contacts import ContactPair
+from clearbench.scenarios.drivers import Driver
+from clearbench.scenarios.expectations import Expectation
+from clearbench.scenarios.joints import ClearanceRevoluteJoint, Joint
+from clearbench.scenarios.loads import Load, Moment, PointForce
+from clearbench.scenarios.outputs import ContactForce, Output
+from clearbench.scenarios.units import UnitSystem
+from clearbench.scenarios.validation import (
     ACCELERATION,
     TIME,
     SceneError,
@@ -305,14 +305,14 @@ class Scene:
 
     def rescaled(self, units: UnitSystem) -> Scene:
         """The same physics expressed in ``units`` (every dimensioned value converted)."""
-        from .serialization import rescale_element
+        from clearbench.scenarios.serialization import rescale_element
 
         return rescale_element(self, self.units, units)
 
     @cached_property
     def content_hash(self) -> str:
         """sha256 of the canonical JSON form: identifies the physics a run was given."""
-        from .serialization import scene_to_dict
+        from clearbench.scenarios.serialization import scene_to_dict
 
         text = json.dumps(scene_to_dict(self), sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(text.encode()).hexdigest()

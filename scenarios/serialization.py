@@ -18,18 +18,18 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
-from . import toml_format
-from .bodies import Body
-from .contacts import ContactPair
-from .drivers import Driver
-from .expectations import Expectation
-from .joints import JOINT_TYPES, ClearanceRevoluteJoint
-from .loads import LOAD_TYPES
-from .outputs import OUTPUT_TYPES
-from .scene import Scene
-from .shapes import SHAPE_TYPES
-from .units import UnitSystem
-from .validation import SceneError
+from clearbench.scenarios import toml_format
+from clearbench.scenarios.bodies import Body
+from clearbench.scenarios.contacts import ContactPair
+from clearbench.scenarios.drivers import Driver
+from clearbench.scenarios.expectations import Expectation
+from clearbench.scenarios.joints import JOINT_TYPES, ClearanceRevoluteJoint
+from clearbench.scenarios.loads import LOAD_TYPES
+from clearbench.scenarios.outputs import OUTPUT_TYPES
+from clearbench.scenarios.scene import Scene
+from clearbench.scenarios.shapes import SHAPE_TYPES
+from clearbench.scenarios.units import UnitSystem
+from clearbench.scenarios.validation import SceneError
 
 #: Element collections of a scene: key -> (kind table or single class).
 COLLECTIONS: dict[str, Any] = {

@@ -34,7 +34,7 @@ import math
 from dataclasses import dataclass, field
 from typing import ClassVar
 
-from .validation import (
+from clearbench.scenarios.validation import (
     LENGTH,
     SceneError,
     check_finite_vector,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .validation import SceneError, check_finite
+from clearbench.scenarios.validation import SceneError, check_finite
 
 
 def check_profile(times_field: str, times, values_field: str, values) -> tuple[tuple, tuple]:

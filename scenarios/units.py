@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .validation import SceneError
+from clearbench.scenarios.validation import SceneError
 
 #: Size of each accepted unit in SI base units.
 LENGTH_UNITS = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6}

@@ -15,8 +15,7 @@ import tomllib
 
 import pytest
 
-from clearbench.harness.cli import main
-from clearbench.scenarios.c60_primitives import (
+from clearbench.scenarios.c60.primitives import (
     PRIMITIVES_PATH,
     Arc,
     Circle,
@@ -26,6 +25,8 @@ from clearbench.scenarios.c60_primitives import (
     compare_documents,
     load_primitives,
 )
+from tools.c60_cad.__main__ import main as extract_main
+from tools.c60_cad.extract import CAD_DIR
 
 DATA_DIR = PRIMITIVES_PATH.parent
 HAS_OCP = importlib.util.find_spec("OCP") is not None
@@ -70,7 +71,7 @@ def test_every_file_reduces_to_primitives_with_small_residuals(primitives):
 
 def test_sha256_of_each_shipped_step_file_matches_the_document(primitives):
     for entry in primitives:
-        digest = hashlib.sha256((DATA_DIR / "cad" / entry.path).read_bytes()).hexdigest()
+        digest = hashlib.sha256((CAD_DIR / entry.path).read_bytes()).hexdigest()
         assert digest == entry.sha256, entry.path
 
 
@@ -141,7 +142,7 @@ def test_compare_documents_reports_differences_beyond_tolerance():
 def test_reextraction_matches_the_committed_document(capsys):
     # c60-extract --check extracts again from the STEP files and compares within the stated
     # tolerance (CHECK_TOLERANCE); exit status 0 means no difference.
-    assert main(["c60-extract", "--check"]) == 0
+    assert extract_main(["--check"]) == 0
     assert "matches" in capsys.readouterr().out
 
 
@@ -151,7 +152,7 @@ def test_check_fails_on_a_changed_document(tmp_path, capsys):
     document["files"][0]["primitives"][0]["residual_mm"] += 1.0e-3
     changed = tmp_path / "primitives.json"
     changed.write_text(json.dumps(document), encoding="utf-8")
-    assert main(["c60-extract", "--check", "--output", str(changed)]) == 1
+    assert extract_main(["--check", "--output", str(changed)]) == 1
     assert "1 differences" in capsys.readouterr().err
 
 
@@ -159,5 +160,5 @@ def test_missing_opencascade_is_a_clear_user_error(monkeypatch, capsys):
     for name in [key for key in sys.modules if key == "OCP" or key.startswith("OCP.")]:
         monkeypatch.setitem(sys.modules, name, None)
     monkeypatch.setitem(sys.modules, "OCP", None)
-    assert main(["c60-extract", "--check"]) == 2
+    assert extract_main(["--check"]) == 2
     assert "pip install -e '.[cad]'" in capsys.readouterr().err

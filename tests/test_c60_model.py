@@ -8,11 +8,11 @@ import math
 import numpy as np
 import pytest
 
-from clearbench.adapters.reference_build import build_system, initial_state
+from clearbench.adapters.reference.build import build_system, initial_state
 from clearbench.ref_solver.forces import applied_forces, no_angle_memory, rotation_matrices
-from clearbench.scenarios import c60_model as model
+from clearbench.scenarios.c60 import model
 from clearbench.scenarios.geometry import check_supported_pair, contacts_between
-from clearbench.scenarios.registry import get_scene, scene_names
+from clearbench.scenarios.library import get_scene, scene_names
 from clearbench.scenarios.serialization import (
     is_close_scene,
     scene_from_dict,
@@ -227,7 +227,7 @@ def test_design_arm_puts_the_handle_moment_about_its_pivot_at_the_law_value():
 
 def test_outputs_in_the_on_pose_are_the_measurement_distances():
     from clearbench.adapters.trajectory import Trajectory
-    from clearbench.harness import metrics
+    from clearbench.harness.measure import series as metrics
 
     scene = get_scene("c60-on")
     positions = np.array([[b.position for b in scene.bodies]])
@@ -257,8 +257,8 @@ def test_outputs_in_the_on_pose_are_the_measurement_distances():
 
 
 def test_twist_angle_differs_from_the_source_angle_at_second_order_in_the_tilt():
+    from clearbench.kernels.quaternion import quat_from_axis_angle, quat_multiply, quat_to_matrix
     from clearbench.ref_solver.forces import twist_angle
-    from clearbench.scenarios.quaternion import quat_from_axis_angle, quat_multiply, quat_to_matrix
 
     z = np.array([0.0, 0.0, 1.0])
     for theta in (-1.2435, -0.3316, 0.6283):

@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 from clearbench.adapters.base import RunSettings
-from clearbench.adapters.reference import create
-from clearbench.harness import c60_analysis as analysis
-from clearbench.harness import metrics
-from clearbench.scenarios import c60_model as model
-from clearbench.scenarios.registry import get_scene
+from clearbench.adapters.reference.engine import create
+from clearbench.harness.c60 import analysis
+from clearbench.harness.measure import series as metrics
+from clearbench.scenarios.c60 import model
+from clearbench.scenarios.library import get_scene
 
 ENGINE = create()
 #: Largest penetration the brief allows [mm]; the projection's tolerance is 1e-10 of the
@@ -74,7 +74,7 @@ def test_on_mechanism_settles_latched_without_penetration(on_run):
     assert drift["FC1_contact_force"] < 1e-2
     assert max(v for k, v in drift.items() if k != "FC1_contact_force") < 1e-4
     # Latched: the hook holds still after 3 ms (1e-4 mm: far below the joints' clearances).
-    from clearbench.harness.expectations import evaluate
+    from clearbench.harness.measure.expectation_figures import evaluate
 
     latched = next(r for r in evaluate(scene, trajectory) if r.name == "stays_latched")
     assert latched.figures["displacement"] < 1e-4
@@ -89,9 +89,9 @@ def test_fc1_is_the_moment_balance_of_the_moving_contact(on_run):
     # Independent static check of the equilibrium: the contact-pressure law's force on the
     # moving contact (M / 6.06 at its centre of mass) has a moment about the needle axis that
     # C7's normal force balances at its lever about that axis.
+    from clearbench.kernels.quaternion import quat_to_matrix
     from clearbench.ref_solver.forces import twist_angle
     from clearbench.scenarios.geometry import contacts_between
-    from clearbench.scenarios.quaternion import quat_to_matrix
 
     scene, trajectory = on_run
     law = next(load for load in scene.loads if load.name == "contact_pressure_spring")

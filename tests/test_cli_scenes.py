@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from clearbench.harness.cli import main
-from clearbench.scenarios.registry import scene_names
+from clearbench.harness.cli.main import main
+from clearbench.scenarios.library import scene_names
 from clearbench.scenarios.serialization import load_scene_file, scene_from_toml
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -3,7 +3,7 @@ exits with status 2."""
 
 from __future__ import annotations
 
-from clearbench.harness.cli import main
+from clearbench.harness.cli.main import main
 
 
 def test_mujoco_table_prints_the_expectation_figures(capsys):

@@ -2,9 +2,9 @@
 
 import csv
 
-from clearbench.harness.cli import main
-from clearbench.harness.fclib_compare import RunRow, performance_profile
-from clearbench.harness.fclib_io import shipped_problem_dir
+from clearbench.harness.cli.main import main
+from clearbench.harness.fclib.compare import RunRow, performance_profile
+from clearbench.harness.fclib.problems import shipped_problem_dir
 
 DATA = shipped_problem_dir()
 

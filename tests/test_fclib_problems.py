@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from clearbench.harness.fclib_io import (
+from clearbench.harness.fclib.problems import (
     UnsupportedProblemError,
     condense_global,
     load_problem,

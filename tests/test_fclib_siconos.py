@@ -6,13 +6,13 @@ Skipped when Siconos cannot be imported by /usr/bin/python3 (install: `make sico
 import numpy as np
 import pytest
 
-from clearbench.adapters import siconos_process
-from clearbench.adapters.siconos_fc3d import (
+from clearbench.adapters.siconos import process as siconos_process
+from clearbench.adapters.siconos.fc3d import (
     siconos_compute_error,
     siconos_read_text_file,
     solve_with_siconos,
 )
-from clearbench.harness.fclib_io import load_problem, shipped_problem_dir
+from clearbench.harness.fclib.problems import load_problem, shipped_problem_dir
 from clearbench.ref_solver import natural_map_residual
 
 DATA = shipped_problem_dir()

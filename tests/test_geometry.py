@@ -8,9 +8,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from clearbench.kernels.gaps import CANONICAL_PAIRS
+from clearbench.kernels.quaternion import quat_from_axis_angle, quat_to_matrix
 from clearbench.scenarios import geometry as G
-from clearbench.scenarios.geometry_pairs import CANONICAL_PAIRS
-from clearbench.scenarios.quaternion import quat_from_axis_angle, quat_to_matrix
 from clearbench.scenarios.shapes import Arc, Box, Capsule, Circle, Cylinder, Plane, Sphere
 
 EPS = np.finfo(float).eps

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from clearbench.harness.cli import build_parser, main
-from clearbench.harness.engine_choice import RunInputError
-from clearbench.harness.store import ResultsStore
-from clearbench.harness.sweep import LadderStep, parse_ladder
+from clearbench.harness.cli.main import build_parser, main
+from clearbench.harness.run.engine_choice import RunInputError
+from clearbench.harness.run.store import ResultsStore
+from clearbench.harness.studies.sweep import LadderStep, parse_ladder
 
 from .harness_helpers import FAKE_OPTION, needs_metrics, write_probe
 
@@ -98,7 +98,7 @@ def test_compare_runs_and_writes_the_report(tmp_path, capsys):
 
 
 def test_stability_runs_every_stiff_case(tmp_path, capsys):
-    from clearbench.scenarios.registry import scene_names
+    from clearbench.scenarios.library import scene_names
 
     assert main(["stability", "-e", "fake", "--store", str(tmp_path / "store"),
                  *FAKE_OPTION]) == 0

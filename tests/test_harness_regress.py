@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import json
 
-from clearbench.harness.cli import main
-from clearbench.harness.regress import Tolerance, compare
+from clearbench.harness.cli.main import main
+from clearbench.harness.studies.regress import Tolerance, compare
 
 from .harness_helpers import FAKE_OPTION, needs_metrics
 

@@ -11,13 +11,13 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from clearbench.harness.cli import main
-from clearbench.harness.report import write_report
-from clearbench.harness.report_figures import work_precision_figure
-from clearbench.harness.run_spec import make_run_spec
-from clearbench.harness.runner import Runner
-from clearbench.harness.store import ResultsStore
-from clearbench.harness.sweep import pareto_front, work_precision_points
+from clearbench.harness.cli.main import main
+from clearbench.harness.report.figures import work_precision_figure
+from clearbench.harness.report.page import write_report
+from clearbench.harness.run.runner import Runner
+from clearbench.harness.run.spec import make_run_spec
+from clearbench.harness.run.store import ResultsStore
+from clearbench.harness.studies.sweep import pareto_front, work_precision_points
 
 from .harness_helpers import FAKE, needs_metrics
 
@@ -125,7 +125,7 @@ def test_work_precision_points_and_figure():
 
 @needs_metrics
 def test_time_series_figure_from_a_fake_run(small_store):
-    from clearbench.harness.report_figures import time_series_figure
+    from clearbench.harness.report.figures import time_series_figure
 
     frame = small_store.dataframe()
     row = frame[(frame["scene_name"] == "bouncing-ball-e0.5")].iloc[0]
@@ -137,7 +137,7 @@ def test_time_series_figure_from_a_fake_run(small_store):
 def test_report_has_the_c60_section_when_the_validation_json_exists(small_store, tmp_path):
     import math
 
-    from clearbench.harness.c60_validation import Row, ValidationReport, write_json
+    from clearbench.harness.c60.validation import Row, ValidationReport, write_json
 
     figure = tmp_path / "reports" / "figures" / "c60_trip_force.png"
     figure.parent.mkdir(parents=True)
@@ -170,7 +170,7 @@ def test_c60_validation_cache_is_keyed_on_the_physics_code(tmp_path, monkeypatch
     # A cached run is reused only by the same scene, preset and physics code: after a solver
     # change the validation reruns instead of reporting the old solver's figures.
     import clearbench
-    from clearbench.harness import c60_validation
+    from clearbench.harness.c60 import validation as c60_validation
 
     first = c60_validation.run_scene("ball", "bouncing-ball-e0", {}, tmp_path)
     assert first.trajectory.metadata["physics_code"] == clearbench.source_digest(

@@ -15,10 +15,10 @@ from pathlib import Path
 
 import pytest
 
-from clearbench.harness.engine_choice import RunInputError, parse_engine_label
-from clearbench.harness.run_spec import make_run_spec
-from clearbench.harness.runner import Runner
-from clearbench.harness.store import ResultsStore
+from clearbench.harness.run.engine_choice import RunInputError, parse_engine_label
+from clearbench.harness.run.runner import Runner
+from clearbench.harness.run.spec import make_run_spec
+from clearbench.harness.run.store import ResultsStore
 
 from .harness_helpers import FAKE, ROOT, subprocess_env
 
@@ -194,7 +194,7 @@ def _stored_count(database: Path) -> int:
 def test_kill_9_of_a_sweep_then_rerun_gives_every_run_exactly_once(tmp_path):
     store = tmp_path / "store"
     ladder = "1e-3,9e-4,8e-4,7e-4,6e-4,5e-4,4e-4,3e-4"
-    command = [sys.executable, "-m", "clearbench.harness.cli", "sweep", "torque-free-flip",
+    command = [sys.executable, "-m", "clearbench.harness.cli.main", "sweep", "torque-free-flip",
                "--engines", "fake", "--engine-module", "fake=tests.fake_engine", "--dt", ladder,
                "--horizon", "8", "--reference-engine", "none", "--store", str(store),
                "--jobs", "2", "--no-progress"]

@@ -10,8 +10,14 @@ import numpy as np
 import pandas as pd
 
 from clearbench.adapters.trajectory import RunStatus, Trajectory
-from clearbench.harness.run_spec import make_run_spec
-from clearbench.harness.store import COLUMNS, ResultsStore, RunRecord, machine_info, revision_info
+from clearbench.harness.run.spec import make_run_spec
+from clearbench.harness.run.store import (
+    COLUMNS,
+    ResultsStore,
+    RunRecord,
+    machine_info,
+    revision_info,
+)
 
 from .harness_helpers import FAKE
 

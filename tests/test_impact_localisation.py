@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 from clearbench.adapters.base import RunSettings
-from clearbench.adapters.reference import create
-from clearbench.adapters.reference_build import build_system, initial_state
+from clearbench.adapters.reference.build import build_system, initial_state
+from clearbench.adapters.reference.engine import create
 from clearbench.ref_solver.stepper import MoreauJeanStepper, StepperSettings, crossing_fraction
-from clearbench.scenarios.registry import get_scene
+from clearbench.scenarios.library import get_scene
 
 
 @pytest.mark.parametrize("gap, speed, acceleration", [

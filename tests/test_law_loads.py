@@ -9,13 +9,13 @@ import numpy as np
 import pytest
 
 from clearbench.adapters.base import RunSettings
-from clearbench.adapters.reference import create
-from clearbench.harness import metrics
+from clearbench.adapters.reference.engine import create
+from clearbench.harness.measure import series as metrics
+from clearbench.kernels.quaternion import quat_from_axis_angle
 from clearbench.scenarios.bodies import Body, Motion
 from clearbench.scenarios.inertia import diagonal
 from clearbench.scenarios.joints import PrismaticJoint, RevoluteJoint
 from clearbench.scenarios.loads import AngleLawLoad, DistanceLawLoad, LoadApplication
-from clearbench.scenarios.quaternion import quat_from_axis_angle
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.serialization import (
     is_close_scene,
@@ -87,7 +87,7 @@ def test_an_angle_law_stays_continuous_through_the_cut(engine):
     # Rest angle 2.8 rad from a start at 0: the torsion pendulum swings to 5.6 rad and back,
     # through the cut of the raw angle at pi, where a law on the raw angle would jump by
     # k 2 pi = 12.6 N m and fling the arm.
-    from clearbench.adapters import mujoco_engine
+    from clearbench.adapters.mujoco import engine as mujoco_engine
 
     stiffness, offset = 2.0, 2.8
     scene = lever_pendulum(offset=offset, stiffness=stiffness)
@@ -197,8 +197,8 @@ def test_application_refuses_a_point_for_a_moment_and_unknown_bodies_are_named()
 
 
 def test_twist_angle_is_the_signed_rotation_about_the_axis():
+    from clearbench.kernels.quaternion import quat_to_matrix
     from clearbench.ref_solver.forces import twist_angle
-    from clearbench.scenarios.quaternion import quat_to_matrix
 
     for angle in (-1.2435, -0.3316, 0.0, 0.6283, 3.0):
         rotation = quat_to_matrix(quat_from_axis_angle(np.array(Z), angle))

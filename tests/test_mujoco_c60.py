@@ -11,22 +11,22 @@ import numpy as np
 import pytest
 
 from clearbench.adapters.base import RunSettings, Support
-from clearbench.adapters.mujoco_build import build_model
-from clearbench.adapters.mujoco_engine import _internal_scene, create
-from clearbench.adapters.mujoco_geometry import (
+from clearbench.adapters.mujoco.build import build_model
+from clearbench.adapters.mujoco.engine import _internal_scene, create
+from clearbench.adapters.mujoco.geometry import (
     bore_piece_count,
     bore_radius_error,
     quat_to_matrix,
     shape_geoms,
 )
-from clearbench.adapters.mujoco_run import Runner
-from clearbench.adapters.mujoco_settings import resolve_settings
-from clearbench.adapters.reference_build import build_system
+from clearbench.adapters.mujoco.run import Runner
+from clearbench.adapters.mujoco.settings import resolve_settings
+from clearbench.adapters.reference.build import build_system
 from clearbench.adapters.trajectory import RunStatus
-from clearbench.harness import metrics
+from clearbench.harness.measure import series as metrics
+from clearbench.kernels.quaternion import quat_from_axis_angle
 from clearbench.ref_solver.forces import element_forces, no_angle_memory
-from clearbench.scenarios.quaternion import quat_from_axis_angle
-from clearbench.scenarios.registry import get_scene, scene_names
+from clearbench.scenarios.library import get_scene, scene_names
 from clearbench.scenarios.shapes import Bore
 
 C60 = scene_names("c60")

@@ -11,18 +11,18 @@ import numpy as np
 import pytest
 
 from clearbench.adapters.base import RunSettings
-from clearbench.adapters.mujoco_engine import create
+from clearbench.adapters.mujoco.engine import create
 from clearbench.adapters.trajectory import RunStatus
-from clearbench.harness import metrics
-from clearbench.harness.expectations import evaluate
+from clearbench.harness.measure import series as metrics
+from clearbench.harness.measure.expectation_figures import evaluate
 from clearbench.scenarios.bodies import Body, Motion
 from clearbench.scenarios.contacts import ContactPair
 from clearbench.scenarios.drivers import Driver
 from clearbench.scenarios.expectations import Expectation
 from clearbench.scenarios.inertia import solid_box, solid_sphere
 from clearbench.scenarios.joints import RevoluteJoint
+from clearbench.scenarios.library import get_scene, scene_names
 from clearbench.scenarios.loads import LinearSpringDamper, Moment, PointForce, TorsionalSpringDamper
-from clearbench.scenarios.registry import get_scene, scene_names
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.shapes import Box, Plane, Sphere
 from clearbench.scenarios.units import MM_G_MS

@@ -10,15 +10,15 @@ import numpy as np
 import pytest
 
 from clearbench.adapters.base import RunSettings, Support
-from clearbench.adapters.mujoco_build import build_model
-from clearbench.adapters.mujoco_engine import create
-from clearbench.adapters.mujoco_settings import resolve_settings
-from clearbench.adapters.mujoco_topology import plan_topology
+from clearbench.adapters.mujoco.build import build_model
+from clearbench.adapters.mujoco.engine import create
+from clearbench.adapters.mujoco.settings import resolve_settings
+from clearbench.adapters.mujoco.topology import plan_topology
+from clearbench.kernels.quaternion import quat_to_matrix
 from clearbench.scenarios.bodies import Body, Motion
 from clearbench.scenarios.drivers import Driver
 from clearbench.scenarios.joints import PrismaticJoint, RevoluteJoint
-from clearbench.scenarios.quaternion import quat_to_matrix
-from clearbench.scenarios.registry import get_scene, scene_names
+from clearbench.scenarios.library import get_scene, scene_names
 from clearbench.scenarios.scene import Scene
 
 NAMES = scene_names()

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from clearbench.adapters.mujoco_run import profile_integral, profile_slope
-from clearbench.adapters.mujoco_settings import (
+from clearbench.adapters.mujoco.run import profile_integral, profile_slope
+from clearbench.adapters.mujoco.settings import (
     PRESETS,
     contact_parameters,
     damping_ratio_for_restitution,

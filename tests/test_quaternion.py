@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from numba import njit
 from scipy.spatial.transform import Rotation
 
-from clearbench.scenarios import quaternion as Q
+from clearbench.kernels import quaternion as Q
 
 # Round-off: a handful of float64 operations on O(1) numbers. 1e-14 leaves about 50 ulp for
 # results that go through a matrix product or a square root.

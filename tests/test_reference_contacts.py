@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from clearbench.adapters.base import RunSettings
-from clearbench.adapters.reference import create
-from clearbench.harness import metrics
+from clearbench.adapters.reference.engine import create
+from clearbench.harness.measure import series as metrics
 from clearbench.scenarios.bodies import Body
 from clearbench.scenarios.contacts import ContactPair
 from clearbench.scenarios.inertia import diagonal

@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 from clearbench.adapters.base import RunSettings
-from clearbench.adapters.reference import create
-from clearbench.harness import metrics
-from clearbench.harness.expectations import evaluate
-from clearbench.scenarios.registry import get_scene
+from clearbench.adapters.reference.engine import create
+from clearbench.harness.measure import series as metrics
+from clearbench.harness.measure.expectation_figures import evaluate
+from clearbench.scenarios.library import get_scene
 from clearbench.scenarios.units import MM_G_MS
 
 ENGINE = create()
@@ -161,7 +161,7 @@ CLEARANCE_LADDER = ((1e-3, 1e-3), (1e-4, 3e-4), (1e-5, 1e-4))
 
 
 def test_clearance_pendulum_approaches_the_ideal_pendulum():
-    from clearbench.harness.benchmarks import clearance_ladder
+    from clearbench.harness.studies.benchmarks import clearance_ladder
 
     errors = [rung.angle_error for rung in clearance_ladder(0.3, CLEARANCE_LADDER)]
     # The difference from the ideal pendulum goes to zero with the clearance: each rung

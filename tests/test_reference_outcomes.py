@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 
 from clearbench.adapters.base import RunSettings
-from clearbench.adapters.reference import create
+from clearbench.adapters.reference.engine import create
 from clearbench.adapters.trajectory import RunStatus
 from clearbench.ref_solver import stepper
-from clearbench.scenarios.registry import get_scene
+from clearbench.scenarios.library import get_scene
 
 
 def test_an_exception_in_a_step_is_a_crashed_run_with_the_state_it_started_from(monkeypatch):
@@ -39,7 +39,7 @@ def test_a_stiction_window_without_samples_gives_no_verdict_instead_of_an_error(
     # are NaN (no verdict), where they used to raise IndexError.
     import math
 
-    from clearbench.harness import metrics
+    from clearbench.harness.measure import series as metrics
 
     scene = get_scene("bouncing-ball-e0.5")
     trajectory = create().run(scene, RunSettings(horizon=5 * scene.time_step))

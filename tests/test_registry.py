@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from clearbench.scenarios.registry import get_entry, get_scene, scene_names
+from clearbench.scenarios.library import get_entry, get_scene, scene_names
 from clearbench.scenarios.serialization import is_close_scene, scene_from_dict, scene_to_dict
 from clearbench.scenarios.units import MM_G_MS
 

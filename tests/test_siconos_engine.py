@@ -13,18 +13,19 @@ import math
 import numpy as np
 import pytest
 
-from clearbench.adapters import siconos_engine, siconos_process
-from clearbench.adapters.availability import engine_availability
 from clearbench.adapters.base import RunSettings, Support
-from clearbench.adapters.reference import create as create_reference
+from clearbench.adapters.reference.engine import create as create_reference
+from clearbench.adapters.registry import engine_availability
+from clearbench.adapters.siconos import engine as siconos_engine
+from clearbench.adapters.siconos import process as siconos_process
 from clearbench.adapters.trajectory import RunStatus, Trajectory
-from clearbench.harness import metrics
-from clearbench.harness.expectations import evaluate
+from clearbench.harness.measure import series as metrics
+from clearbench.harness.measure.expectation_figures import evaluate
 from clearbench.scenarios.bodies import Body, Motion
 from clearbench.scenarios.contacts import ContactPair
 from clearbench.scenarios.inertia import diagonal, solid_box
+from clearbench.scenarios.library import get_scene, scene_names
 from clearbench.scenarios.loads import LinearSpringDamper, Moment, PointForce
-from clearbench.scenarios.registry import get_scene, scene_names
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.shapes import Box, Plane
 

@@ -1,7 +1,7 @@
 """The Siconos worker's plain-numpy geometry agrees with the shared geometry module.
 
 The worker runs under Debian's Python without numba, so it carries its own copy of the
-formulas (adapters/siconos_worker_geometry.py). These tests run in the project's environment
+formulas (adapters/siconos/worker/geometry.py). These tests run in the project's environment
 (no Siconos needed) and compare both on random configurations of every pair the worker supports,
 in both orders.
 """
@@ -13,9 +13,9 @@ import math
 import numpy as np
 import pytest
 
-from clearbench.adapters import siconos_worker_geometry as worker
+from clearbench.adapters.siconos.worker import geometry as worker
+from clearbench.kernels.quaternion import quat_normalize, quat_to_matrix
 from clearbench.scenarios import geometry as shared
-from clearbench.scenarios.quaternion import quat_normalize, quat_to_matrix
 
 # 1e-12 [m] on configurations of size ~1 m: a few hundred ulp. Both sides run the same
 # operations in the same order; differences come only from libm/np.roots round-off (the ring

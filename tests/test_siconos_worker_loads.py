@@ -3,7 +3,7 @@ force evaluation (``ref_solver.forces.applied_forces``) at random states, and th
 declares what it does not know UNSUPPORTED.
 
 The worker module runs under Debian's Python; it imports only numpy and its sibling
-``siconos_worker_geometry`` (by bare name), so it is imported here from its folder. Siconos
+``geometry`` (by bare name), so it is imported here from its folder. Siconos
 itself is imported only when a model is built, which these tests never do: they run without
 Siconos.
 """
@@ -19,24 +19,24 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from clearbench.adapters import siconos_engine
 from clearbench.adapters.base import RunSettings, Support
-from clearbench.adapters.reference_build import build_system
+from clearbench.adapters.reference.build import build_system
+from clearbench.adapters.siconos import engine as siconos_engine
 from clearbench.adapters.trajectory import RunStatus
+from clearbench.kernels.quaternion import quat_normalize, quat_to_matrix
 from clearbench.ref_solver.forces import applied_forces, no_angle_memory, rotation_matrices
+from clearbench.scenarios.library import get_scene, scene_names
 from clearbench.scenarios.loads import AngleLawLoad, DistanceLawLoad, LoadApplication
-from clearbench.scenarios.quaternion import quat_normalize, quat_to_matrix
-from clearbench.scenarios.registry import get_scene, scene_names
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.serialization import scene_to_json
 
 
 @pytest.fixture(scope="module")
 def worker():
-    folder = str(Path(siconos_engine.__file__).parent)
+    folder = str(Path(siconos_engine.__file__).parent / "worker")
     sys.path.insert(0, folder)
     try:
-        yield importlib.import_module("siconos_worker_engine")
+        yield importlib.import_module("engine")
     finally:
         sys.path.remove(folder)
 

@@ -147,8 +147,8 @@ def test_stall_after_delays_the_early_stop():
 
 def test_reference_engine_uses_the_floor_by_default_and_counts_its_steps():
     from clearbench.adapters.base import RunSettings
-    from clearbench.adapters.reference import create
-    from clearbench.scenarios.registry import get_scene
+    from clearbench.adapters.reference.engine import create
+    from clearbench.scenarios.library import get_scene
 
     scene = get_scene("incline-stick")
     engine = create()

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from clearbench.scenarios.registry import get_scene
+from clearbench.scenarios.library import get_scene
 from clearbench.scenarios.serialization import scene_from_dict, scene_to_dict
 from clearbench.scenarios.validation import SceneError
 

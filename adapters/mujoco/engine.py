@@ -1,0 +1,174 @@
+"""The MuJoCo engine: a scene rebuilt in MuJoCo (see :mod:`.mujoco_build`), stepped with
+guards, and read out into the common :class:`~.trajectory.Trajectory`.
+
+Presets (each a separate engine variant ``mujoco[<preset>]``; see :mod:`.mujoco_settings`):
+
+- ``default``: MuJoCo's own defaults (pyramidal cone, solref (0.02, 1), solimp
+  (0.9, 0.95, 0.001), Euler, Newton, 100 iterations, no noslip);
+- ``tuned``: elliptic cone + 10 noslip iterations, solref (2 dt, 1), solimp
+  (0.99, 0.999, 1e-5) for contacts and loop closures, as ENGINES.md measured; plastic pairs
+  (e = 0) mapped to dampratio 3 like every other restitution.
+
+Every pair with e > 0 gets dampratio zeta(e) of a unilateral spring-damper in both presets
+(MuJoCo has no restitution parameter; see :mod:`.mujoco_settings`).
+
+``RunSettings.options`` override any field of :class:`~.mujoco_settings.MujocoSettings`.
+
+Units: MuJoCo's absolute defaults (solimp width 1 mm, collision tolerance 1e-6) assume metres
+and seconds, so a scene in other units is rescaled to SI for MuJoCo (``internal_units``) and
+its results converted back; the trajectory metadata says so.
+
+Guards: before the run, every soft constraint's stiffness*dt^2 and damping*dt (per unit mass)
+is checked against 1 and a warning recorded; during the run a non-finite state or a MuJoCo
+warning (bad acceleration, contact buffer full) stops the run as DIVERGED, and so does an
+energy gain above ``energy_gain_tolerance`` of the energy scale on scenes whose expectations
+say energy may only decrease (``energy_non_increasing``, ``energy_conserved``).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+
+from clearbench.adapters.base import Capability, Engine, RunSettings
+from clearbench.adapters.mujoco.capabilities import (
+    bore_summary,
+    clearance_summary,
+    mujoco_capabilities,
+    ring_summary,
+)
+from clearbench.adapters.mujoco.run import Runner
+from clearbench.adapters.mujoco.settings import (
+    OPTION_NAMES,
+    PRESETS,
+    MujocoSettings,
+    resolve_settings,
+)
+from clearbench.adapters.trajectory import RunStatus, Trajectory
+from clearbench.scenarios.scene import Scene
+from clearbench.scenarios.units import SI
+from clearbench.scenarios.validation import TIME, VELOCITY
+
+logger = logging.getLogger(__name__)
+
+__all__ = ["OPTION_NAMES", "PRESETS", "MujocoEngine", "availability", "create"]
+
+
+def availability() -> tuple[bool, str]:
+    try:
+        import mujoco
+    except ImportError as error:  # pragma: no cover - mujoco is a dependency
+        return False, f"mujoco does not import: {error}"
+    return True, f"mujoco {mujoco.__version__}"
+
+
+def create(preset: str = "default") -> MujocoEngine:
+    return MujocoEngine(preset)
+
+
+class MujocoEngine(Engine):
+    """MuJoCo (soft contacts, joint-coordinate trees) with a named preset."""
+
+    name = "mujoco"
+
+    def __init__(self, preset: str = "default"):
+        if preset not in PRESETS:
+            raise ValueError(f"unknown mujoco preset {preset!r}; presets: {list(PRESETS)}")
+        self.preset = preset
+
+    def settings(self, options: dict | None = None) -> MujocoSettings:
+        """The preset overridden by ``options``."""
+        return resolve_settings(self.preset, options)
+
+    def capabilities(self, scene: Scene, options: dict | None = None) -> dict[str, Capability]:
+        return mujoco_capabilities(scene, self.settings(options))
+
+    def _run(self, scene: Scene, settings: RunSettings) -> Trajectory:
+        from clearbench.adapters.mujoco.build import build_model
+
+        config = self.settings(settings.options)
+        start = time.perf_counter()
+        internal = _internal_scene(scene, config)
+        to_internal = scene.units.factor_to(internal.units, TIME)
+        dt = (settings.time_step or scene.time_step) * to_internal
+        horizon = (settings.horizon or scene.horizon) * to_internal
+        built = build_model(internal, config, dt)
+        steps = int(math.ceil(horizon / dt - 1e-9))
+        record = list(range(0, steps + 1, settings.record_every))
+        if record[-1] != steps:
+            record.append(steps)
+        runner = Runner(internal, built, config, steps, len(record))
+        build_seconds = time.perf_counter() - start
+        status, message = _with_logged_warnings(runner, record)
+        trajectory = runner.trajectory(scene, internal)
+        trajectory.engine = self.name
+        trajectory.preset = self.preset
+        trajectory.build_seconds = build_seconds
+        trajectory.stepping_seconds = runner.stepping_seconds
+        trajectory.steps = runner.steps_taken
+        trajectory.status = status
+        trajectory.message = message
+        trajectory.metadata = _metadata(scene, internal, config, built, runner)
+        return trajectory
+
+
+def _with_logged_warnings(runner, record: list[int]) -> tuple[RunStatus, str]:
+    """Run with MuJoCo's text warnings sent to logging (instead of MUJOCO_LOG.TXT in the
+    working directory) and kept for the metadata; the previous handler is restored."""
+    import mujoco
+
+    previous = mujoco.get_mju_user_warning()
+
+    def handler(text: str) -> None:
+        logger.warning("mujoco: %s", text)
+        if len(runner.warnings) < 100:
+            runner.warnings.append(f"mujoco: {text}")
+
+    mujoco.set_mju_user_warning(handler)
+    try:
+        return runner.run(record)
+    finally:
+        mujoco.set_mju_user_warning(previous)
+
+
+def _internal_scene(scene: Scene, config: MujocoSettings) -> Scene:
+    if config.internal_units == "SI" and scene.units != SI:
+        return scene.rescaled(SI)
+    return scene
+
+
+def _metadata(scene: Scene, internal: Scene, config: MujocoSettings, built, runner) -> dict:
+    import mujoco
+
+    if internal.units != scene.units:
+        units = (f"scene in {scene.units.describe()} rescaled to {internal.units.describe()} "
+                 "for MuJoCo; results converted back")
+    else:
+        units = f"run in the scene's units ({scene.units.describe()})"
+    to_internal = scene.units.factor_to(internal.units, TIME)
+    return {
+        "mujoco_version": mujoco.__version__,
+        "settings": config.as_dict(),
+        "units": units,
+        "time_step_internal": built.model.opt.timestep,
+        "time_step_scene": built.model.opt.timestep / to_internal,
+        "warnings": list(built.warnings) + runner.warnings,
+        "guards": runner.guard_notes,
+        "contact_solref": [list(p.solref) for p in built.contact_parameters],
+        "contact_dampratio": [p.damping_ratio for p in built.contact_parameters],
+        "rings": ring_summary(scene, config),
+        "bores": bore_summary(scene, config),
+        "clearance_joints": clearance_summary(scene, config),
+        "tree": [[link.body, link.parent, link.kind, link.joint]
+                 for link in built.topology.links],
+        "loop_closures": list(built.topology.closures),
+        "initial_velocity_residual": built.initial_velocity_residual
+        * internal.units.factor_to(scene.units, VELOCITY),
+        "mujoco_warnings": runner.mujoco_warnings,
+        "energy_initial": runner.energy_initial,
+        "energy_max_gain": runner.energy_max_gain,
+        "unconverged_steps": runner.unconverged[:1000],
+        "unconverged_count": len(runner.unconverged),
+        "max_contacts": runner.max_contacts,
+    }

@@ -1,0 +1,426 @@
+"""The step loop of a MuJoCo run: drivers, loads, guards, read-out into trajectory arrays.
+
+Used by :mod:`.mujoco_engine`; works on a model built by :mod:`.mujoco_build`, in the model's
+internal units, and converts the samples back to the scene's units at the end.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+
+import numpy as np
+
+from clearbench.adapters.mujoco.settings import MujocoSettings
+from clearbench.adapters.trajectory import RunStatus, Trajectory
+from clearbench.scenarios.bodies import Motion
+from clearbench.scenarios.loads import LinearSpringDamper, Moment, PointForce, TorsionalSpringDamper
+from clearbench.scenarios.scene import Scene
+from clearbench.scenarios.validation import (
+    ANGULAR_VELOCITY,
+    FORCE,
+    LENGTH,
+    TIME,
+    VELOCITY,
+)
+
+logger = logging.getLogger(__name__)
+
+#: Expectation kinds under which the energy of the scene may not grow.
+ENERGY_EXPECTATIONS = ("energy_non_increasing", "energy_conserved")
+#: Features that do work the energy bookkeeping does not count (the guard stays off).
+WORK_FEATURES = ("drivers", "point_forces", "moments", "angle_law_loads", "distance_law_loads")
+
+
+def profile_integral(times, values, t) -> np.ndarray:
+    """Exact integral from 0 to ``t`` (T,) of the piecewise-linear profile (constant outside
+    its breakpoints; jumps where two breakpoints coincide)."""
+    knots = np.asarray(times, dtype=float)
+    levels = np.asarray(values, dtype=float)
+    t = np.asarray(t, dtype=float)
+
+    def antiderivative(x):
+        x = np.asarray(x, dtype=float)
+        if len(knots) == 1:
+            return levels[0] * (x - knots[0])
+        widths = np.diff(knots)
+        cumulative = np.concatenate(([0.0], np.cumsum(0.5 * (levels[:-1] + levels[1:])
+                                                      * widths)))
+        index = np.clip(np.searchsorted(knots, x, side="right") - 1, 0, len(knots) - 2)
+        width = widths[index]
+        slope = np.where(width > 0, (levels[index + 1] - levels[index])
+                         / np.where(width > 0, width, 1.0), 0.0)
+        offset = x - knots[index]
+        inside = cumulative[index] + levels[index] * offset + 0.5 * slope * offset**2
+        before = levels[0] * (x - knots[0])
+        after = cumulative[-1] + levels[-1] * (x - knots[-1])
+        return np.where(x < knots[0], before, np.where(x >= knots[-1], after, inside))
+
+    return antiderivative(t) - antiderivative(0.0)
+
+
+def profile_slope(times, values, t) -> np.ndarray:
+    """Right derivative of the piecewise-linear profile at ``t`` (T,)."""
+    knots = np.asarray(times, dtype=float)
+    levels = np.asarray(values, dtype=float)
+    t = np.asarray(t, dtype=float)
+    if len(knots) == 1:
+        return np.zeros_like(t)
+    index = np.clip(np.searchsorted(knots, t, side="right") - 1, 0, len(knots) - 2)
+    width = knots[index + 1] - knots[index]
+    slope = np.where(width > 0, (levels[index + 1] - levels[index])
+                     / np.where(width > 0, width, 1.0), 0.0)
+    return np.where((t < knots[0]) | (t >= knots[-1]), 0.0, slope)
+
+
+class Runner:
+    """The step loop of one run: drivers, loads, guards, and sampling into arrays."""
+
+    def __init__(self, scene: Scene, built, config: MujocoSettings, steps: int, samples: int):
+        import mujoco
+
+        self.mujoco = mujoco
+        self.scene = scene
+        self.built = built
+        self.config = config
+        self.steps = steps
+        self.model, self.data = built.model, built.data
+        model = self.model
+        self.dt = model.opt.timestep
+        nb = len(scene.bodies)
+        npair = len(scene.all_contacts)
+        self.ids = built.body_ids
+        self.movable = np.array([b.motion is not Motion.FIXED for b in scene.bodies])
+        self.mass = np.array([b.mass for b in scene.bodies])
+        self.inertia = np.array([np.asarray(b.inertia, dtype=float) for b in scene.bodies])
+        self.gravity = np.asarray(scene.gravity, dtype=float)
+        self.times = np.zeros(samples)
+        self.positions = np.zeros((samples, nb, 3))
+        self.orientations = np.zeros((samples, nb, 4))
+        self.velocities = np.zeros((samples, nb, 3))
+        self.omegas = np.zeros((samples, nb, 3))
+        self.normal = np.zeros((samples, npair))
+        self.force = np.zeros((samples, npair, 3))
+        self.iterations = np.zeros(samples, dtype=np.int64)
+        self.residual = np.full(samples, np.nan)
+        self.converged = np.ones(samples, dtype=bool)
+        self.active = np.zeros(samples, dtype=np.int64)
+        self.count = 0
+        self.stepping_seconds = 0.0
+        self.steps_taken = 0
+        self.unconverged: list[int] = []
+        self.warnings: list[str] = []
+        self.guard_notes: list[str] = []
+        self.mujoco_warnings: dict[str, int] = {}
+        self.max_contacts = 0
+        self.energy_initial = float("nan")
+        self.energy_max_gain = 0.0
+        self._kinetic_max = 0.0
+        self._iterations = 0
+        self._residual = 0.0
+        self._converged = True
+        self._springs = [load for load in scene.loads if isinstance(load, LinearSpringDamper)]
+        self._site_ids = [(model.site(f"{s.name}:a").id, model.site(f"{s.name}:b").id)
+                          for s in self._springs]
+        self._hinge_springs = built.hinge_springs
+        self._energy_guard = self._energy_guard_applies()
+        self._size_energy = self._size_energy_scale()
+        step_times = np.arange(steps + 1) * self.dt
+        self._drive = []
+        for dof in built.driven:
+            driver = dof.driver
+            if driver.quantity == "position":
+                position = np.asarray(driver.displacement(step_times), dtype=float)
+                velocity = np.asarray(driver.velocity(step_times), dtype=float)
+                acceleration = np.zeros_like(step_times)
+            else:
+                position = profile_integral(driver.times, driver.values, step_times)
+                velocity = np.asarray(driver.velocity(step_times), dtype=float)
+                acceleration = profile_slope(driver.times, driver.values, step_times)
+            armature = model.dof_armature[dof.dof_address]
+            self._drive.append((dof, dof.initial + dof.sign * position, dof.sign * velocity,
+                                armature * dof.sign * acceleration))
+
+    # ------------------------------------------------------------------ guards
+    def _energy_guard_applies(self) -> bool:
+        kinds = {e.kind for e in self.scene.expectations}
+        if not kinds & set(ENERGY_EXPECTATIONS):
+            self.guard_notes.append("energy guard off: no energy expectation")
+            return False
+        work = sorted(set(WORK_FEATURES) & self.scene.features)
+        if work:
+            self.guard_notes.append(f"energy guard off: {', '.join(work)} do uncounted work")
+            return False
+        self.guard_notes.append(
+            f"energy guard on: stops when energy exceeds its initial value by more than "
+            f"{self.config.energy_gain_tolerance:g} x the energy scale (largest kinetic energy "
+            f"so far, at least sum(m |g|) x largest shape size), checked every "
+            f"{self.config.guard_interval} steps and at every sample")
+        return True
+
+    def _size_energy_scale(self) -> float:
+        size = 0.0
+        for body in self.scene.expanded.bodies:
+            for shape in body.shapes:
+                values = [getattr(shape, "radius", 0.0), getattr(shape, "half_length", 0.0)]
+                values += list(getattr(shape, "half_extents", ()))
+                size = max(size, *values)
+        g = float(np.linalg.norm(self.gravity))
+        return float(np.sum(self.mass[self.movable])) * g * size
+
+    def _check_warnings(self) -> str | None:
+        counts = self.data.warning.number
+        if not counts.any():
+            return None
+        names = {int(value): name for name, value in self.mujoco.mjtWarning.__members__.items()
+                 if name != "mjNWARNING"}
+        fatal = ("mjWARN_BADQPOS", "mjWARN_BADQVEL", "mjWARN_BADQACC", "mjWARN_CONTACTFULL",
+                 "mjWARN_CNSTRFULL")
+        message = None
+        for index, count in enumerate(counts):
+            if count and index in names:
+                name = names[index]
+                if count != self.mujoco_warnings.get(name, 0):
+                    self.mujoco_warnings[name] = int(count)
+                    if name in fatal and message is None:
+                        message = f"MuJoCo warning {name} at t = {self.data.time:.6g}"
+        return message
+
+    # ------------------------------------------------------------------ state
+    def refresh_kinematics(self) -> None:
+        """Poses and velocities of the current qpos/qvel (mj_step leaves them one step old);
+        contact and constraint arrays are left untouched."""
+        mj = self.mujoco
+        mj.mj_kinematics(self.model, self.data)
+        mj.mj_comPos(self.model, self.data)
+        mj.mj_comVel(self.model, self.data)
+
+    def body_state(self):
+        """Body-frame poses, centre-of-mass velocities (world) and angular velocities (body
+        axes) of every scene body: (nb, 3), (nb, 4), (nb, 3), (nb, 3)."""
+        d, ids = self.data, self.ids
+        rotation = d.xmat[ids].reshape(-1, 3, 3)
+        omega = d.cvel[ids, :3]
+        offset = d.xipos[ids] - d.subtree_com[self.model.body_rootid[ids]]
+        velocity = d.cvel[ids, 3:] + np.cross(omega, offset)
+        omega_body = np.einsum("bji,bj->bi", rotation, omega)
+        return d.xpos[ids].copy(), d.xquat[ids].copy(), velocity, omega_body
+
+    def energy(self) -> tuple[float, float]:
+        """(total, kinetic) mechanical energy as harness.metrics.energy counts it: kinetic,
+        gravity and spring potential (internal units)."""
+        d, ids = self.data, self.ids
+        _, _, velocity, omega = self.body_state()
+        m = self.movable
+        kinetic = 0.5 * np.sum(self.mass[m] * np.sum(velocity[m] ** 2, axis=1))
+        kinetic += 0.5 * np.einsum("bi,bij,bj->", omega[m], self.inertia[m], omega[m])
+        potential = -np.sum(self.mass[m] * (d.xipos[ids][m] @ self.gravity))
+        springs = 0.0
+        for load, (sa, sb) in zip(self._springs, self._site_ids, strict=True):
+            stretch = np.linalg.norm(d.site_xpos[sb] - d.site_xpos[sa]) - load.rest_length
+            springs += load.preload * stretch + 0.5 * load.stiffness * stretch**2
+        for load, qadr, sign in self._hinge_springs:
+            phi = sign * d.qpos[qadr]
+            springs += load.preload * phi + 0.5 * load.stiffness * (phi - load.rest_angle) ** 2
+        for python_load in self.built.python_loads:
+            load = python_load.load
+            if isinstance(load, TorsionalSpringDamper):
+                phi = python_load.angle
+                springs += load.preload * phi + 0.5 * load.stiffness * (phi - load.rest_angle) ** 2
+        return float(kinetic + potential + springs), float(kinetic)
+
+    def check_energy(self) -> str | None:
+        total, kinetic = self.energy()
+        self._kinetic_max = max(self._kinetic_max, kinetic)
+        gain = total - self.energy_initial
+        scale = max(self._kinetic_max, self._size_energy, 1e-300)
+        self.energy_max_gain = max(self.energy_max_gain, gain / scale)
+        if gain > self.config.energy_gain_tolerance * scale:
+            return (f"energy gain {gain:.4g} (internal units) = {gain / scale:.3g} x the energy "
+                    f"scale at t = {self.data.time:.6g}: above the tolerance "
+                    f"{self.config.energy_gain_tolerance:g} on a scene whose energy may only "
+                    "decrease")
+        return None
+
+    # ------------------------------------------------------------------ loads
+    def apply_loads(self) -> None:
+        """xfrc_applied of point forces, moments, explicit torsional springs and law loads at
+        the state of the step start (kinematics from mj_step1)."""
+        d = self.data
+        laws = self.built.law_forces
+        if not self.built.python_loads and laws is None:
+            return
+        d.xfrc_applied[:] = 0.0
+        if laws is not None:
+            laws.apply(d)
+        t = d.time
+        for item in self.built.python_loads:
+            load = item.load
+            b = item.body_id
+            rotation = d.xmat[b].reshape(3, 3)
+            if isinstance(load, PointForce | Moment):
+                end = math.inf if load.end_time is None else load.end_time
+                if not load.start_time <= t < end:
+                    continue
+                if isinstance(load, PointForce):
+                    force = np.asarray(load.force, dtype=float)
+                    force = rotation @ force if load.frame == "body" else force
+                    point = d.xpos[b] + rotation @ np.asarray(load.point, dtype=float)
+                    d.xfrc_applied[b, :3] += force
+                    d.xfrc_applied[b, 3:] += np.cross(point - d.xipos[b], force)
+                else:
+                    moment = np.asarray(load.moment, dtype=float)
+                    d.xfrc_applied[b, 3:] += rotation @ moment if load.frame == "body" \
+                        else moment
+                continue
+            a_id, b_id = item.body_id, item.other_id
+            rotation_a = d.xmat[a_id].reshape(3, 3)
+            rotation_b = d.xmat[b_id].reshape(3, 3)
+            axis = rotation_a @ item.axis_in_a
+            ref_a = rotation_a @ item.reference_a
+            ref_b = rotation_b @ item.reference_b
+            angle = math.atan2(float(axis @ np.cross(ref_a, ref_b)), float(ref_a @ ref_b))
+            previous = math.remainder(item.angle, 2.0 * math.pi)
+            item.angle += math.remainder(angle - previous, 2.0 * math.pi)
+            rate = float(axis @ (d.cvel[b_id, :3] - d.cvel[a_id, :3]))
+            moment = -(load.preload + load.stiffness * (item.angle - load.rest_angle)
+                       + load.damping * rate) * axis
+            d.xfrc_applied[b_id, 3:] += moment
+            d.xfrc_applied[a_id, 3:] -= moment
+
+    # ------------------------------------------------------------------ loop
+    def run(self, record: list[int]) -> tuple[RunStatus, str]:
+        mj = self.mujoco
+        model, data = self.model, self.data
+        self.refresh_kinematics()
+        self.store(0)
+        self.energy_initial, kinetic = self.energy()
+        self._kinetic_max = kinetic
+        next_record = 1
+        interval = self.config.guard_interval
+        iterations_cap = model.opt.iterations
+        for k in range(1, self.steps + 1):
+            tick = time.perf_counter()
+            for dof, position, velocity, force in self._drive:
+                data.qpos[dof.qpos_address] = position[k - 1]
+                data.qvel[dof.dof_address] = velocity[k - 1]
+                data.qfrc_applied[dof.dof_address] = force[k - 1]
+            mj.mj_step1(model, data)
+            self.apply_loads()
+            mj.mj_step2(model, data)
+            self.stepping_seconds += time.perf_counter() - tick
+            self.steps_taken = k
+            islands = min(max(int(data.nisland), 1), len(data.solver_niter))
+            niter = int(data.solver_niter[:islands].max())
+            self._iterations += niter
+            if niter >= iterations_cap:
+                self._converged = False
+                self.unconverged.append(k)
+            self.max_contacts = max(self.max_contacts, int(data.ncon))
+            problem = self._check_warnings()
+            if problem is None and not (np.isfinite(data.qpos).all()
+                                        and np.isfinite(data.qvel).all()):
+                problem = f"non-finite state at step {k} (t = {data.time:.6g})"
+            recording = next_record < len(record) and k == record[next_record]
+            checking = self._energy_guard and k % interval == 0
+            if problem is None and (recording or checking):
+                forces = self.contact_forces() if recording else None
+                self.refresh_kinematics()
+                if self._energy_guard:
+                    problem = self.check_energy()
+                if recording:
+                    self.store(next_record, forces)
+                    next_record += 1
+            elif problem is not None and next_record < len(record):
+                # Keep the offending state as the last sample.
+                forces = self.contact_forces()
+                self.refresh_kinematics()
+                self.store(next_record, forces)
+                next_record += 1
+            if problem is not None:
+                self.count = next_record
+                logger.info("%s: stopped: %s", self.scene.name, problem)
+                return RunStatus.DIVERGED, problem
+        self.count = next_record
+        return RunStatus.OK, ""
+
+    # ------------------------------------------------------------------ read-out
+    def contact_forces(self) -> tuple[np.ndarray, np.ndarray, int]:
+        """Per scene pair: normal force sum (npair,) and total force on body B, world
+        (npair, 3), from the constraint forces of the step just taken; and active contacts."""
+        mj = self.mujoco
+        model, data = self.model, self.data
+        npair = self.normal.shape[1]
+        normal = np.zeros(npair)
+        total = np.zeros((npair, 3))
+        active = 0
+        wrench = np.zeros(6)
+        for i in range(data.ncon):
+            contact = data.contact[i]
+            if contact.exclude != 0 or contact.efc_address < 0:
+                continue
+            key = tuple(sorted((int(contact.geom[0]), int(contact.geom[1]))))
+            pair = self.built.pair_lookup.get(key)
+            if pair is None:
+                continue
+            mj.mj_contactForce(model, data, i, wrench)
+            if wrench[0] <= 0.0:
+                continue
+            active += 1
+            frame = contact.frame.reshape(3, 3)
+            world = frame.T @ wrench[:3]
+            sign = 1.0 if model.geom_bodyid[contact.geom[1]] == self.built.contact_body_b[pair] \
+                else -1.0
+            normal[pair] += wrench[0]
+            total[pair] += sign * world
+        return normal, total, active
+
+    def solver_residual(self) -> float:
+        data = self.data
+        islands = min(max(int(data.nisland), 1), len(data.solver_niter))
+        worst = 0.0
+        for island in range(islands):
+            n = int(data.solver_niter[island])
+            if n > 0:
+                stat = data.solver[island * self.mujoco.mjNSOLVER + min(n, self.mujoco.mjNSOLVER)
+                                   - 1]
+                worst = max(worst, float(stat.gradient))
+        return worst
+
+    def store(self, i: int, forces=None) -> None:
+        position, orientation, velocity, omega = self.body_state()
+        self.times[i] = self.data.time
+        self.positions[i] = position
+        self.orientations[i] = orientation
+        self.velocities[i] = velocity
+        self.omegas[i] = omega
+        if forces is not None:
+            self.normal[i], self.force[i], self.active[i] = forces
+            self.iterations[i] = self._iterations
+            self.residual[i] = self.solver_residual()
+            self.converged[i] = self._converged
+            self._iterations, self._converged = 0, True
+
+    def trajectory(self, scene: Scene, internal: Scene) -> Trajectory:
+        """Samples converted back to the scene's units."""
+        n = self.count
+        back = internal.units
+
+        def factor(dimension):
+            return back.factor_to(scene.units, dimension)
+
+        return Trajectory(
+            engine="", preset="", scene_name=scene.name, scene_hash=scene.content_hash,
+            units={"length": scene.units.length, "mass": scene.units.mass,
+                   "time": scene.units.time},
+            time_step=self.dt * factor(TIME), body_names=tuple(b.name for b in scene.bodies),
+            contact_names=tuple(c.name for c in scene.all_contacts),
+            times=self.times[:n] * factor(TIME), positions=self.positions[:n] * factor(LENGTH),
+            orientations=self.orientations[:n], velocities=self.velocities[:n] * factor(VELOCITY),
+            angular_velocities=self.omegas[:n] * factor(ANGULAR_VELOCITY),
+            contact_normal_force=self.normal[:n] * factor(FORCE),
+            contact_force=self.force[:n] * factor(FORCE),
+            solver_iterations=self.iterations[:n], solver_residual=self.residual[:n],
+            solver_converged=self.converged[:n], active_contacts=self.active[:n],
+        )

@@ -1,0 +1,264 @@
+"""Figures of the C-60 runs: functional conditions at equilibrium, trip events, the bench
+experiments' force-displacement curves, and checks of the contacts against their CAD faces.
+
+Every function takes the scene (as the engine was given it) and the trajectory; lengths in mm,
+times in ms, forces in N (the scene's mm-g-ms units).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from clearbench.adapters.trajectory import Trajectory
+from clearbench.harness.measure import series as metrics
+from clearbench.scenarios.c60 import model
+from clearbench.scenarios.c60 import primitives as prim
+from clearbench.scenarios.geometry import contacts_between, shape_world_placement
+from clearbench.scenarios.scene import Scene
+from clearbench.scenarios.shapes import Cylinder
+
+#: A contact carries force when its normal force exceeds this [N] (1e-6 of the 1-30 N forces
+#: of the mechanism; the solver's residual tolerance puts round-off far below it).
+FORCE_THRESHOLD = 1e-6
+
+
+def window_mean(values: np.ndarray, times: np.ndarray, start: float, end: float) -> float:
+    """Mean of ``values`` over the samples with start <= t <= end."""
+    inside = (times >= start) & (times <= end)
+    return float(np.mean(values[inside])) if inside.any() else math.nan
+
+
+def settled_outputs(scene: Scene, trajectory: Trajectory, window: float = 1.0) -> dict:
+    """Every named output averaged over the last ``window`` ms of the run."""
+    end = float(trajectory.times[-1])
+    values = metrics.output_values(scene, trajectory)
+    return {name: window_mean(v, trajectory.times, end - window, end)
+            for name, v in values.items()}
+
+
+def output_drift(scene: Scene, trajectory: Trajectory, window: float = 1.0) -> dict:
+    """Largest change of each output over the last ``window`` ms (is it settled?)."""
+    times = trajectory.times
+    inside = times >= times[-1] - window
+    return {name: float(np.ptp(v[inside]))
+            for name, v in metrics.output_values(scene, trajectory).items()}
+
+
+@dataclass(frozen=True)
+class TripEvents:
+    """Times [ms] of the magnetic trip (NaN when it did not happen in the run).
+
+    strike: the plunger first pushes the tripping bar (TRIP contacts carry force);
+    release: after the strike, the hook's latch contacts on the tripping bar (C4, C5) first
+    carry no force (the latch let go);
+    opening: after the release, C7's gap (moving on fixed contact) first exceeds ``open_gap``
+    (0.1 mm: clear of the chatter within the joints' clearances that follows the release);
+    chatter: C7's closures (force > 0 after a sample with none) between release and opening;
+    gap_after: C7's smallest gap over the ``after`` ms following the opening [mm] (> 0: the
+    contacts did not close again).
+    """
+
+    strike: float
+    release: float
+    opening: float
+    chatter: int
+    gap_after: float
+
+    @property
+    def opening_after_strike(self) -> float:
+        return self.opening - self.strike
+
+
+def _first(mask: np.ndarray, times: np.ndarray, after: float) -> float:
+    hits = np.nonzero(mask & (times > after))[0]
+    return float(times[hits[0]]) if hits.size else math.nan
+
+
+def trip_events(scene: Scene, trajectory: Trajectory, open_gap: float = 0.1,
+                after: float = 1.0) -> TripEvents:
+    names = trajectory.contact_names
+    force = trajectory.contact_normal_force
+    times = trajectory.times
+    trip = [i for i, n in enumerate(names) if n.startswith("TRIP_")]
+    strike = _first(force[:, trip].sum(axis=1) > FORCE_THRESHOLD, times, -math.inf)
+    latch = [i for i, n in enumerate(names) if n.startswith(("Hook_Tbar_C4", "Tbar_Hook_C5"))]
+    release = _first(force[:, latch].sum(axis=1) <= FORCE_THRESHOLD, times, strike)
+    c7 = names.index(model.C7)
+    column = [c.name for c in scene.contacts].index(model.C7)
+    gaps = metrics.contact_gaps(scene, trajectory)[:, column]
+    opening = _first((force[:, c7] <= FORCE_THRESHOLD) & (gaps > open_gap), times, release)
+    between = (times > release) & (times < opening)
+    loaded = force[:, c7] > FORCE_THRESHOLD
+    chatter = int(np.sum(loaded[1:] & ~loaded[:-1] & between[1:]))
+    window = (times >= opening) & (times <= opening + after)
+    gap_after = float(np.min(gaps[window])) if window.any() else math.nan
+    return TripEvents(strike, release, opening, chatter, gap_after)
+
+
+@dataclass(frozen=True)
+class TripForceCurve:
+    """Probe force against its displacement since first contact (Section 5.3)."""
+
+    displacement: np.ndarray
+    force: np.ndarray
+    peak_force: float
+    peak_displacement: float
+    trip_distance: float
+
+
+def running_median(values: np.ndarray, width: int) -> np.ndarray:
+    """Median of each window of ``width`` (odd) samples centred on each sample (edges padded
+    with the end values)."""
+    half = width // 2
+    padded = np.concatenate((np.full(half, values[0]), values, np.full(half, values[-1])))
+    windows = np.lib.stride_tricks.sliding_window_view(padded, width)
+    return np.median(windows, axis=1)
+
+
+def trip_force_curve(scene: Scene, trajectory: Trajectory, median_width: int = 5,
+                     released_for: float = 0.02, release_transient: float = 0.005
+                     ) -> TripForceCurve:
+    """Probe force against displacement since first contact.
+
+    The release is where the force drops to zero for at least ``released_for`` mm of probe
+    travel (the latch let go; NaN if it never does); the trip distance is the displacement
+    there. The peak is the largest force over the loading phase, taken on the force smoothed
+    by a running median of ``median_width`` recorded samples and up to ``release_transient``
+    mm before the release: the first touch and the release are impacts (the bar kicked
+    against the probe as the latch lets go: up to 16 N in single 0.02 ms samples) that a
+    quasi-static load cell does not register. The curve itself is returned raw.
+    """
+    values = metrics.output_values(scene, trajectory)
+    force = values["probe_force"]
+    position = values["probe_y"]
+    touching = np.nonzero(force > FORCE_THRESHOLD)[0]
+    if touching.size == 0:
+        empty = np.zeros(0)
+        return TripForceCurve(empty, empty, math.nan, math.nan, math.nan)
+    first = touching[0]
+    displacement = position[first:] - position[first]
+    force = force[first:]
+    loaded = force > FORCE_THRESHOLD
+    release = None
+    for index in np.nonzero(loaded[:-1] & ~loaded[1:])[0] + 1:
+        later = np.nonzero(loaded[index:])[0]
+        reloaded_at = displacement[index + later[0]] if later.size else math.inf
+        if reloaded_at - displacement[index] >= released_for:
+            release = index
+            break
+    trip = float(displacement[release]) if release is not None else math.nan
+    limit = trip - release_transient if release is not None else math.inf
+    smooth = running_median(force, median_width)
+    window = np.nonzero(displacement <= limit)[0]
+    peak = int(window[np.argmax(smooth[window])])
+    return TripForceCurve(displacement, force, float(smooth[peak]), float(displacement[peak]),
+                          trip)
+
+
+@dataclass(frozen=True)
+class ContactForceCurve:
+    """Section 5.2: force on the probe against its position, forward then backward.
+
+    ``displacement`` is measured from the position where the probe first carries load on the
+    forward stroke; ``equilibrium_force`` is the mean force over the second half of the hold at
+    the reference position; ``loaded_travel`` the displacement from first load to the
+    reference."""
+
+    forward_displacement: np.ndarray
+    forward_force: np.ndarray
+    backward_displacement: np.ndarray
+    backward_force: np.ndarray
+    equilibrium_force: float
+    loaded_travel: float
+
+
+def contact_force_curve(scene: Scene, trajectory: Trajectory) -> ContactForceCurve:
+    values = metrics.output_values(scene, trajectory)
+    force = values["probe_force"]
+    x = values["probe_x"] - values["probe_x"][0]
+    times = trajectory.times
+    driver = next(d for d in scene.drivers if d.name == "probe_x")
+    start, reach, leave, end = driver.times[-4:]
+    forward = (times >= start) & (times <= reach)
+    hold = (times >= 0.5 * (reach + leave)) & (times <= leave)
+    backward = (times >= leave) & (times <= end)
+    loaded = np.nonzero(forward & (force > FORCE_THRESHOLD))[0]
+    origin = float(x[loaded[0]]) if loaded.size else math.nan
+    return ContactForceCurve(
+        x[forward] - origin, force[forward], x[backward] - origin, force[backward],
+        float(np.mean(force[hold])) if hold.any() else math.nan,
+        float(np.max(x) - origin))
+
+
+def _patch_ranges() -> dict[tuple[str, str], tuple[float, float]]:
+    """(body, shape) -> angular range of the convex cylinder patches the scene models as full
+    cylinders (their own frame: angle from x about z, as :class:`~.shapes.Arc`)."""
+    ranges = {}
+    for contact in model.load_model()["contacts"]:
+        for side in ("1", "2"):
+            cad = contact[f"cad{side}"]
+            surfaces = [p for p in model.primitives()[cad].primitives
+                        if not isinstance(p, prim.Point)]
+            labels = model.face_labels(cad, len(surfaces))
+            for label, primitive in zip(labels, surfaces, strict=True):
+                if (not isinstance(primitive, prim.Cylinder) or isinstance(primitive, prim.Ring)
+                        or primitive.is_full or primitive.material == "outside"):
+                    continue
+                name = cad.rsplit("/", 1)[-1].removesuffix(".stp") + (
+                    f"_{label}" if label else "")
+                ranges[(contact[f"body{side}"], name)] = (primitive.start_angle,
+                                                          primitive.end_angle)
+    return ranges
+
+
+def patch_excursions(scene: Scene, trajectory: Trajectory, end: float = math.inf
+                     ) -> dict[str, float]:
+    """For every contact pair on a convex cylinder PATCH (modelled as a full cylinder), the
+    largest angle [rad] by which a contact point that carries force lies outside the CAD
+    patch's angular range (0 when it always stays on the patch), over the recorded samples
+    up to time ``end`` [ms]."""
+    ranges = _patch_ranges()
+    bodies = {b.name: b for b in scene.bodies}
+    out = {}
+    for contact in scene.contacts:
+        for side in ("a", "b"):
+            body = getattr(contact, f"body_{side}")
+            shape_name = getattr(contact, f"shape_{side}")
+            if (body, shape_name) not in ranges:
+                continue
+            start, end = ranges[(body, shape_name)]
+            shape = bodies[body].shape(shape_name)
+            if not isinstance(shape, Cylinder):
+                raise TypeError(f"{body}.{shape_name} is a {shape.kind}, not the cylinder "
+                                "a convex patch is modelled by")
+            worst = 0.0
+            column = trajectory.contact_index(contact.name)
+            a, b = bodies[contact.body_a], bodies[contact.body_b]
+            ia, ib = scene.body_index(contact.body_a), scene.body_index(contact.body_b)
+            ib_side = ia if side == "a" else ib
+            carrying = (trajectory.contact_normal_force[:, column] > FORCE_THRESHOLD) & (
+                trajectory.times <= end)
+            for t in np.nonzero(carrying)[0]:
+                pose_a = (trajectory.positions[t, ia], trajectory.orientations[t, ia])
+                pose_b = (trajectory.positions[t, ib], trajectory.orientations[t, ib])
+                result = contacts_between(a.shape(contact.shape_a), pose_a,
+                                          b.shape(contact.shape_b), pose_b)
+                points = result.point_a if side == "a" else result.point_b
+                gaps = result.gap - contact.offset
+                position, rotation = shape_world_placement(
+                    shape, trajectory.positions[t, ib_side], trajectory.orientations[t, ib_side])
+                for point, gap in zip(points, gaps, strict=True):
+                    if gap > 1e-3:  # an open candidate of the pair (the far rim points)
+                        continue
+                    local = rotation.T @ (point - position)
+                    angle = math.atan2(local[1], local[0])
+                    offset = (angle - start) % (2 * math.pi)
+                    span = end - start
+                    if offset > span:
+                        outside = min(offset - span, 2 * math.pi - offset)
+                        worst = max(worst, outside)
+            out[contact.name] = worst
+    return out

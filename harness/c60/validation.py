@@ -1,0 +1,622 @@
+"""The C-60 validation table: our runs against the published figures (Akhadkar, Acary,
+Brogliato 2018, Sections 4.2 and 5), with the differences reported, never tuned away.
+
+:func:`validate` runs the scenes it needs with the reference engine (each run cached as a
+trajectory file keyed by the scene's content hash), computes the figures and returns a
+:class:`ValidationReport`; :func:`write_markdown` and :func:`write_figures` render it.
+"""
+
+from __future__ import annotations
+
+import functools
+import logging
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+import clearbench
+from clearbench.adapters.base import RunSettings
+from clearbench.adapters.reference.engine import create
+from clearbench.adapters.trajectory import Trajectory
+from clearbench.harness.c60 import analysis
+from clearbench.harness.measure import series as metrics
+from clearbench.scenarios.c60 import model
+from clearbench.scenarios.library import get_scene
+from clearbench.scenarios.scene import Scene
+
+logger = logging.getLogger(__name__)
+
+#: Relative difference above which the report says what we believe causes it.
+EXPLAIN_ABOVE = 0.10
+#: A bench test at a raised probe speed stands for the study's 0.5 mm/s when a run at half the
+#: speed gives the same curve within these: 2 % of its forces (the paper's simulation and
+#: measurement differ by 2 % on FC-1) and 0.01 mm of its distances (2 % of the 0.44 mm trip).
+SPEED_FORCE_TOLERANCE = 0.02
+SPEED_DISTANCE_TOLERANCE = 0.01
+
+
+@dataclass(frozen=True)
+class Run:
+    """One cached run: the scene, its trajectory, and how long stepping took [s]."""
+
+    key: str
+    scene: Scene
+    trajectory: Trajectory
+
+    @property
+    def unconverged(self) -> list:
+        return list(self.trajectory.metadata.get("unconverged_steps", []))
+
+    @functools.cached_property
+    def penetration(self) -> float:
+        """Largest contact penetration over the recorded states [mm] (computed once)."""
+        depth = metrics.penetration(self.scene, self.trajectory)
+        return float(depth.max()) if depth.size else 0.0
+
+
+def run_scene(key: str, name: str, parameters: dict, cache: Path | None, preset: str = "default",
+              record_every: int = 10) -> Run:
+    """Run a registered scene with the reference engine, or read it back from ``cache``: a
+    cached run is reused when its scene, preset and physics code (the sources of the scenes,
+    the solver and the adapters, :data:`PHYSICS_CODE`) are this run's."""
+    scene = get_scene(name, **parameters)
+    code = clearbench.source_digest(PHYSICS_CODE)
+    path = cache / f"{key}.npz" if cache is not None else None
+    if path is not None and path.exists():
+        trajectory = Trajectory.load(path)
+        if (trajectory.scene_hash == scene.content_hash and trajectory.preset == preset
+                and trajectory.metadata.get("physics_code") == code):
+            logger.info("%s: read from %s", key, path)
+            return Run(key, scene, trajectory)
+    logger.info("%s: running %s %s (%s steps)", key, name, parameters,
+                round(scene.horizon / scene.time_step))
+    tick = time.perf_counter()
+    trajectory = create(preset).run(scene, RunSettings(record_every=record_every))
+    logger.info("%s: %.0f s", key, time.perf_counter() - tick)
+    trajectory.metadata["physics_code"] = code
+    if path is not None:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        trajectory.save(path)
+    return Run(key, scene, trajectory)
+
+
+#: The subpackages whose sources decide a cached run's trajectory.
+PHYSICS_CODE = ("clearbench.kernels", "clearbench.scenarios", "clearbench.ref_solver",
+                "clearbench.adapters")
+
+#: Largest contact penetration the C-60 runs may show [mm] (the issue's limit); a run beyond
+#: it is a finding of the report.
+PENETRATION_LIMIT = 1e-6
+
+
+@dataclass(frozen=True)
+class Row:
+    """One line of the table: our figure beside the paper's (NaN where it gives none)."""
+
+    quantity: str
+    unit: str
+    ours: float
+    paper_simulated: float = math.nan
+    paper_measured: float = math.nan
+    note: str = ""
+
+    def difference(self) -> float:
+        """Relative difference to the measured value, else to the paper's simulated one."""
+        reference = self.paper_measured if not math.isnan(self.paper_measured) \
+            else self.paper_simulated
+        return (self.ours - reference) / abs(reference) if reference else math.nan
+
+
+@dataclass
+class ValidationReport:
+    rows: list[Row] = field(default_factory=list)
+    runs: dict[str, Run] = field(default_factory=dict)
+    curves: dict = field(default_factory=dict)
+    findings: list[str] = field(default_factory=list)
+
+
+def _paper() -> dict:
+    return model.load_model()["paper"]
+
+
+def validate(cache: Path | None = None, preset: str = "default", speed_check: bool = True,
+             sensitivity: bool = True) -> ValidationReport:
+    """Run what the table needs and fill it (see the module docstring)."""
+    report = ValidationReport()
+    paper = _paper()
+    experiments = paper["experiments"]
+    fcs = paper["functional_conditions"]
+    prototype = model.prototype_clearances()
+
+    def run(key, name, parameters, record_every=10):
+        report.runs[key] = run_scene(key, name, parameters, cache, preset, record_every)
+        return report.runs[key]
+
+    # Equilibrium in the ON pose: nominal (the sheet's) and prototype clearances.
+    nominal = run("on_nominal", "c60-on", {})
+    settled = analysis.settled_outputs(nominal.scene, nominal.trajectory)
+    on_proto = run("on_prototype", "c60-on", {"clearances": prototype})
+    settled_proto = analysis.settled_outputs(on_proto.scene, on_proto.trajectory)
+    force = experiments["contact_force_at_equilibrium_N"]
+    report.rows.append(Row(
+        "FC-1, C7 force at equilibrium, prototype clearances (c60-on)", "N",
+        settled_proto["FC1_contact_force"], force["simulated"], force["measured"]))
+    report.rows.append(Row(
+        "FC-1, nominal clearances (c60-on) vs Monte Carlo mean", "N",
+        settled["FC1_contact_force"], fcs["FC1"]["mean"],
+        note=f"Monte Carlo range {fcs['FC1']['range'][0]}-{fcs['FC1']['range'][1]} N"))
+    for fc, key in (("FC-2", "FC2"), ("FC-3", "FC3"), ("FC-4", "FC4"), ("FC-5", "FC5"),
+                    ("FC-6", "FC6")):
+        output, description = model.FUNCTIONAL_CONDITIONS[fc]
+        report.rows.append(Row(f"{fc}, {output} (c60-on, nominal) vs Monte Carlo mean", "mm",
+                               settled[output], fcs[key]["mean"],
+                               note=f"sigma {fcs[key]['sigma']} mm; {description}"))
+    if sensitivity:
+        for key, parameters, label in (
+                ("on_design_arm", {"handle_spring_arm": "design"},
+                 "handle spring at its design arm"),
+                ("on_preload_0.9599", {"contact_spring_preload": 0.9599},
+                 "contact spring preload 0.9599 rad (the source's commented alternative)")):
+            variant = run(key, "c60-on", parameters)
+            value = analysis.settled_outputs(variant.scene, variant.trajectory)
+            report.rows.append(Row(f"FC-1 with {label}, nominal clearances", "N",
+                                   value["FC1_contact_force"], fcs["FC1"]["mean"],
+                                   note="sensitivity, not the model"))
+
+    # The magnetic trip.
+    trip = run("trip", "c60-trip", {})
+    events = analysis.trip_events(trip.scene, trip.trajectory)
+    report.curves["trip_events"] = events
+    report.rows.append(Row("c60-trip: plunger strikes the tripping bar", "ms", events.strike,
+                           note="no published figure"))
+    report.rows.append(Row("c60-trip: latch released (C4, C5 unloaded)", "ms", events.release,
+                           note="no published figure"))
+    report.rows.append(Row("c60-trip: contacts open (C7 gap > 0.1 mm)", "ms",
+                           events.opening, note=f"no published figure; {events.chatter} C7 "
+                           f"re-closures between release and opening; smallest C7 gap in the "
+                           f"1 ms after: {events.gap_after:.3f} mm"))
+    report.findings.append(_trip_failure(trip))
+
+    # Bench: contact force vs displacement (prototype clearances).
+    contact = run("contact_force_test", "c60-contact-force-test", {}, record_every=20)
+    contact_ok = _bench_run_usable(contact, report)
+    if contact_ok:
+        curve = analysis.contact_force_curve(contact.scene, contact.trajectory)
+        report.curves["contact_force"] = {"v": curve}
+        report.rows.append(Row("Contact-force test: force at the reference position", "N",
+                               curve.equilibrium_force, force["simulated"], force["measured"],
+                               note="handle spring at its design arm, see the model notes"))
+        report.rows.append(Row("Contact-force test: loaded travel to the reference", "mm",
+                               curve.loaded_travel,
+                               paper_measured=experiments["contact_test_total_displacement_mm"]))
+    if sensitivity and contact_ok:
+        preload = run("contact_force_test_preload_0.9599", "c60-contact-force-test",
+                      {"contact_spring_preload": 0.9599}, record_every=20)
+        preload_curve = analysis.contact_force_curve(preload.scene, preload.trajectory)
+        report.curves["contact_force"]["preload 0.9599 rad"] = preload_curve
+        report.rows.append(Row("Contact-force test: force at the reference, contact spring "
+                               "preload 0.9599 rad", "N", preload_curve.equilibrium_force,
+                               force["simulated"], force["measured"],
+                               note="sensitivity, not the model"))
+    # Bench: tripping force vs displacement (prototype clearances).
+    trip_test = run("trip_force_test", "c60-trip-force-test", {}, record_every=20)
+    trip_curve = analysis.trip_force_curve(trip_test.scene, trip_test.trajectory)
+    report.curves["trip_force"] = {"v": trip_curve}
+    peak = experiments["trip_test_peak_force_N"]
+    distance = experiments["trip_test_total_distance_mm"]
+    report.rows.append(Row("Trip test: peak force", "N", trip_curve.peak_force,
+                           peak["simulated"], peak["measured"]))
+    report.rows.append(Row("Trip test: displacement at the peak", "mm",
+                           trip_curve.peak_displacement,
+                           paper_measured=experiments["trip_test_peak_at_mm"]))
+    report.rows.append(Row("Trip test: total trip distance", "mm", trip_curve.trip_distance,
+                           distance["simulated"], distance["measured"]))
+    report.findings.append(_first_contact_phase(trip_test))
+    if sensitivity:
+        design = run("trip_force_test_design_arm", "c60-trip-force-test",
+                     {"handle_spring_arm": "design"}, record_every=20)
+        design_curve = analysis.trip_force_curve(design.scene, design.trajectory)
+        report.curves["trip_force"]["design arm"] = design_curve
+        report.rows.append(Row("Trip test: peak force, handle spring at its design arm", "N",
+                               design_curve.peak_force, peak["simulated"], peak["measured"],
+                               note="sensitivity, not the model"))
+        report.rows.append(Row("Trip test: trip distance, handle spring at its design arm",
+                               "mm", design_curve.trip_distance, distance["simulated"],
+                               distance["measured"], note="sensitivity, not the model"))
+        preload = run("trip_force_test_preload_0.9599", "c60-trip-force-test",
+                      {"contact_spring_preload": 0.9599}, record_every=20)
+        preload_curve = analysis.trip_force_curve(preload.scene, preload.trajectory)
+        report.curves["trip_force"]["preload 0.9599 rad"] = preload_curve
+        report.rows.append(Row("Trip test: peak force, contact spring preload 0.9599 rad", "N",
+                               preload_curve.peak_force, peak["simulated"], peak["measured"],
+                               note="sensitivity, not the model"))
+        report.rows.append(Row("Trip test: trip distance, contact spring preload 0.9599 rad",
+                               "mm", preload_curve.trip_distance, distance["simulated"],
+                               distance["measured"], note="sensitivity, not the model"))
+    report.findings.append(explain_contact_force(nominal))
+    if speed_check:
+        base_speed = _probe_speed(trip_test.scene)
+        slow = run("trip_force_test_half_speed", "c60-trip-force-test",
+                   {"probe_speed": 0.5 * base_speed}, record_every=40)
+        slow_curve = analysis.trip_force_curve(slow.scene, slow.trajectory)
+        report.curves["trip_force"]["v/2"] = slow_curve
+        same = _same_curve(trip_curve.peak_force, slow_curve.peak_force,
+                           trip_curve.trip_distance, slow_curve.trip_distance)
+        report.findings.append(
+            f"Trip test at {base_speed} mm/ms and at half that speed: peak force "
+            f"{trip_curve.peak_force:.4f} / {slow_curve.peak_force:.4f} N, peak at "
+            f"{trip_curve.peak_displacement:.4f} / {slow_curve.peak_displacement:.4f} mm, trip "
+            f"distance {trip_curve.trip_distance:.4f} / {slow_curve.trip_distance:.4f} mm: "
+            + ("the same curve within" if same else "NOT the same curve within")
+            + f" the stated tolerance ({100 * SPEED_FORCE_TOLERANCE:.0f} % of the peak force, "
+            f"{SPEED_DISTANCE_TOLERANCE} mm of trip distance).")
+    if speed_check and contact_ok:
+        contact_speed = _probe_speed(contact.scene)
+        slow = run("contact_force_test_half_speed", "c60-contact-force-test",
+                   {"probe_speed": 0.5 * contact_speed}, record_every=40)
+        slow_contact = analysis.contact_force_curve(slow.scene, slow.trajectory)
+        report.curves["contact_force"]["v/2"] = slow_contact
+        same = _same_curve(curve.equilibrium_force, slow_contact.equilibrium_force,
+                           curve.loaded_travel, slow_contact.loaded_travel)
+        report.findings.append(
+            f"Contact-force test at {contact_speed} and {0.5 * contact_speed} mm/ms: force at "
+            f"the reference {curve.equilibrium_force:.4f} / "
+            f"{slow_contact.equilibrium_force:.4f} N, loaded travel {curve.loaded_travel:.4f} / "
+            f"{slow_contact.loaded_travel:.4f} mm: "
+            + ("the same curve within" if same else "NOT the same curve within")
+            + " the stated tolerance.")
+    for key, done in report.runs.items():
+        if done.trajectory.status.value != "ok":
+            report.findings.append(f"Run {key} ({done.scene.name}) ended "
+                                   f"{done.trajectory.status.value}: {done.trajectory.message}")
+        if done.penetration > PENETRATION_LIMIT:
+            report.findings.append(
+                f"Run {key} ({done.scene.name}): a contact penetrates {done.penetration:.3g} mm, "
+                f"beyond the issue's {PENETRATION_LIMIT:g} mm "
+                f"({len(done.trajectory.metadata.get('unconverged_projections', []))} steps "
+                "whose projection did not reach its tolerance).")
+    return report
+
+
+def _same_curve(force: float, slow_force: float, distance: float, slow_distance: float) -> bool:
+    """A bench curve and its half-speed rerun agree: key force [N] within
+    SPEED_FORCE_TOLERANCE of the slow run's, key distance [mm] within
+    SPEED_DISTANCE_TOLERANCE."""
+    return (abs(force - slow_force) <= SPEED_FORCE_TOLERANCE * slow_force
+            and abs(distance - slow_distance) <= SPEED_DISTANCE_TOLERANCE)
+
+
+def _bench_run_usable(run: Run, report: ValidationReport) -> bool:
+    """True if a bench run ended ok with its probe loaded; otherwise a finding says that it
+    gives no curve and why (probe never loaded, when the mechanism's fastest body first
+    exceeded 10 mm/ms). A run that did not end ok is also reported with its status and message
+    by :func:`validate`, once for every run."""
+    values = metrics.output_values(run.scene, run.trajectory)
+    loaded = bool(np.any(values["probe_force"] > analysis.FORCE_THRESHOLD))
+    if run.trajectory.status.value == "ok" and loaded:
+        return True
+    speeds = np.abs(run.trajectory.velocities).max(axis=2).max(axis=1)
+    fast = np.nonzero(speeds > 10.0)[0]
+    onset = (f"; the mechanism's fastest body exceeds 10 mm/ms from t = "
+             f"{run.trajectory.times[fast[0]]:.2f} ms" if fast.size else "")
+    report.findings.append(
+        f"{run.key} ({run.scene.name}): no curve (status {run.trajectory.status.value}"
+        f"{', probe never loaded' if not loaded else ''}{onset}).")
+    return False
+
+
+def _probe_speed(scene: Scene) -> float:
+    """Pushing speed of a bench scene's probe [mm/ms]."""
+    driver = next(d for d in scene.drivers if d.body == "probe"
+                  and d.component in ("x", "y") and len(d.times) > 1)
+    if driver.quantity == "velocity":
+        return float(driver.values[-1])
+    # A position profile ends forward stroke, hold, backward stroke: the forward stroke's speed.
+    times, values = driver.times, driver.values
+    return float((values[-3] - values[-4]) / (times[-3] - times[-4]))
+
+
+def _first_contact_phase(run: Run) -> str:
+    """Where the trip test's probe first touched the pin: in the slow phase, as it must."""
+    values = metrics.output_values(run.scene, run.trajectory)
+    touching = np.nonzero(values["probe_force"] > analysis.FORCE_THRESHOLD)[0]
+    driver = next(d for d in run.scene.drivers if d.name == "probe_y")
+    slow_from = driver.times[3]
+    if touching.size == 0:
+        return "Trip test: the probe never touched the pin."
+    first = float(run.trajectory.times[touching[0]])
+    phase = "in the slow phase" if first >= slow_from else "BEFORE the slow phase"
+    return (f"Trip test: first probe contact at {first:.3f} ms, {phase} (slow from "
+            f"{slow_from:.3f} ms).")
+
+
+def explain_contact_force(run: Run) -> str:
+    """Why FC-1 is what it is: the moving contact's moment balance about the needle, with the
+    figures of the run's last sample."""
+    from clearbench.kernels.quaternion import quat_to_matrix
+    from clearbench.ref_solver.forces import twist_angle
+
+    scene, trajectory = run.scene, run.trajectory
+    z = np.array([0.0, 0.0, 1.0])
+    law = next(load for load in scene.loads if load.name == "contact_pressure_spring")
+    angles = {}
+    for name in ("moving_contact", "plate"):
+        q = trajectory.orientations[-1, scene.body_index(name)]
+        angles[name] = twist_angle(quat_to_matrix(q / np.linalg.norm(q)), z)
+    moment = law.stiffness * (law.offset + angles["moving_contact"] - angles["plate"])
+    index = scene.body_index("moving_contact")
+    rotation = quat_to_matrix(trajectory.orientations[-1, index])
+    centre = trajectory.positions[-1, index] + rotation @ np.asarray(
+        scene.body("moving_contact").center_of_mass)
+    application = law.applications[2]
+    direction = rotation @ np.asarray(application.unit_direction())
+    force = moment * application.gain(True) * direction
+    needle = trajectory.positions[-1, scene.body_index("needle")]
+    law_moment = float(np.cross(centre - needle, force)[2])
+    fc1 = float(trajectory.contact_normal_force[-1, trajectory.contact_index(model.C7)])
+    lever = abs(law_moment) / fc1 if fc1 > 0 else math.nan
+    return (f"FC-1 follows from the moving contact's moment balance about the needle: the "
+            f"contact-pressure law gives M = {moment:.1f} N mm at equilibrium, its force "
+            f"M/6.06 along the moving contact's body (0.6, -1.1, -0.01) has a moment of "
+            f"{abs(law_moment):.1f} N mm about the needle axis, which C7 balances at a lever of "
+            f"{lever:.2f} mm: FC-1 = {fc1:.2f} N (joint friction and the contact's tangential "
+            f"force make up the rest). About 15 N would need M near "
+            f"{15.0 * lever * abs(moment / law_moment):.0f} N mm with these levers.")
+
+
+#: What the source does that a reader of the paper would not expect (all checked in the source
+#: and reproduced by the scene, see clearbench.scenarios.c60.model).
+MODEL_NOTES = (
+    "Loads are the source's plugin laws, with their physical signs (Siconos subtracts the "
+    "'internal' forces the plugin returns negated); the bar's settling moment is therefore "
+    "-15 N mm about z for t < 1 ms (its function returns +15 un-negated).",
+    "Handle spring: the source takes its initial angle unsigned (2 acos(q0_w) = +0.3316 rad "
+    "for a -0.3316 rad pose), so the law is 3.82 (1.99 + 0.3316 - theta) N mm; and it takes the "
+    "moment about the centre of mass with the arm R (P0 - z0), where Siconos passes the "
+    "initial centre-of-mass position in world as z0: the force acts 21 mm from the pivot "
+    "(27.1 N mm about it instead of the law's 10.1). The default scene reproduces this; "
+    "`handle_spring_arm='design'` applies the evident intent.",
+    "Contact-force test: the probe settles at the reference (the fixed contact's place), "
+    "retreats 2.2 mm at 0.5 mm/ms, then gives the curve forward to the reference and back. "
+    "Once the moving contact rests on its stop C6 (about 2.0 mm back) nothing loads the "
+    "mechanism: with the source's handle arm the handle then leaves its ON pose within 1 ms "
+    "and the mechanism opens, so the test runs with the design arm, with which it stays "
+    "latched (see clearbench.scenarios.c60.bench).",
+    "Contact-pressure spring: M = 244.46 (theta_mc - theta_plate + 76.54 deg + 0.49 rad) "
+    "N mm in this version of the source; its comment lists 0.6547 and 0.9599 rad as other "
+    "preloads.",
+    "Needle: the paper's mass and inertia (the source has placeholders); its centre of mass "
+    "(0, 0, 5) in the body frame lies 5 mm off its axis in both the source and the paper.",
+    "Joint J1's top ring has 0.041 mm radial clearance with the sheet's offsets (0.52 mm CAD "
+    "gap), twice the other joints' 0.021 mm; the needle's S3 bearings 0.006 mm.",
+    "Plane faces reach 0.5 mm behind their surface (c60_model.FACE_DEPTH): after the trip "
+    "the handle turns freely (the source has no OFF stop) and brings its ON-stop face round "
+    "behind the case's stop pins; without a depth that counted as an 8.5 mm penetration at "
+    "15.2 ms and the projection tore the handle out of its bearing.",
+    "Angle laws take each body's angle about the law's axis as the source's 2 acos(q_w) "
+    "does, but continuous: a body turning through the cut of the raw angle (pi) keeps its law "
+    "continuous (the source's would jump by k 2 pi; in the ON and trip runs no law body comes "
+    "near the cut). `benchmarks/c60_body_angles.py TRAJECTORY.npz` prints each body's raw "
+    "angle and the largest body speed along a run (the runs are cached in .cache/c60/).",
+    "Bounded faces: TRIP_1 and C3 ON 1, 2 have their nearest point beyond the face (no "
+    "contact candidate; OpenCASCADE measures to the face's edge, 0.86 and 3.8 mm in the ON "
+    "pose). Every other ON-pose gap agrees with OpenCASCADE within the CAD's B-spline residual "
+    "(1.2e-4 mm).",
+)
+
+
+#: What we believe causes a difference above 10 % from the paper, by the start of the row's
+#: quantity. A belief, stated as such: none of these has been confirmed by a run that removes the
+#: cause.
+DIFFERENCE_CAUSES = (
+    ("FC-1", "the source's contact-pressure law, M = 244.46 (D + 0.49) N mm, balances at C7 "
+     "with about 7.4 N at the levers of the assembled CAD (the moment balance is in the "
+     "findings); about 15 N needs M near 300 N mm, so the paper's model had a stiffer or more "
+     "preloaded contact spring than this version of the source. The contact spring preload is "
+     "the one parameter the source comments as uncertain (0.49, 0.6547 or 0.9599 rad)."),
+    ("Contact-force test: force at the reference", "the probe stands in for the fixed "
+     "contact, so the force at the reference is FC-1 of this configuration (the same moment "
+     "balance of the source's contact-pressure law, see the FC-1 rows); the loaded travel, "
+     "which depends on the geometry, agrees with the measured 2.0 mm."),
+    ("FC-", "one run at the nominal clearances compared with the mean of the paper's Monte "
+     "Carlo over manufacturing tolerances, and measurement pairs whose names pair oddly with "
+     "the paper's FC definitions (see the functional conditions above): the x distances agree "
+     "within 1.2 %, the y distances do not, which points at the pairs' y reference, not at "
+     "the dynamics."),
+    ("Trip test: peak force", "the force needed to pull the tripping-bar pin is set by the "
+     "latch load (C4, C5) times its friction, and the latch load by the handle and contact "
+     "springs; with the source's handle-spring arm (21 mm from the pivot instead of the law's "
+     "design arm, see the model notes) and its contact law (FC-1 above is half the paper's), "
+     "the latch of this model is loaded differently from the paper's. The displacement at the "
+     "peak and the trip distance, which depend on the latch geometry rather than on its load, "
+     "agree within 9 %."),
+)
+
+
+def difference_cause(quantity: str) -> str:
+    """What we believe causes the difference of the row ``quantity`` (see DIFFERENCE_CAUSES)."""
+    for prefix, cause in DIFFERENCE_CAUSES:
+        if quantity.startswith(prefix):
+            return cause
+    return "not analysed."
+
+
+def _fmt(value: float, digits: int = 3) -> str:
+    return "-" if value is None or (isinstance(value, float) and math.isnan(value)) \
+        else f"{value:.{digits}f}"
+
+
+def write_markdown(report: ValidationReport, path: Path, figures: dict[str, Path],
+                   preset: str) -> None:
+    """The table, the findings and the runs' statistics as Markdown."""
+    lines = [
+        "# C-60 validation: the reference engine against the published figures",
+        "",
+        "Generated by `clearbench c60 validate` (reference engine, preset "
+        f"`{preset}`, h = 1e-3 ms as the source). Paper: Akhadkar, Acary, Brogliato, "
+        "Multibody System Dynamics 42(3), 2018 (seed document), Sections 4.2 and 5. "
+        "Differences are relative to the measured value where there is one, else to the "
+        "paper's simulated value; nothing is tuned to them.",
+        "",
+        "| quantity | unit | ours | paper, simulated | paper, measured | difference |",
+        "|---|---|---|---|---|---|",
+    ]
+    for row in report.rows:
+        difference = row.difference()
+        text = "-" if math.isnan(difference) else f"{100 * difference:+.1f} %"
+        note = f" ({row.note})" if row.note else ""
+        lines.append(f"| {row.quantity}{note} | {row.unit} | {_fmt(row.ours)} | "
+                     f"{_fmt(row.paper_simulated)} | {_fmt(row.paper_measured)} | {text} |")
+    lines += ["", "## Functional conditions: how each is computed", ""]
+    for fc, (output, description) in model.FUNCTIONAL_CONDITIONS.items():
+        lines.append(f"- {fc}: output `{output}`, {description}; averaged over the last "
+                     "millisecond of c60-on.")
+    lines += ["- The paper's Monte Carlo means pair oddly with the measurement pairs' names "
+              "(FC-2 10.72 mm is near the lamage axis x, FC-4 10.60 mm near the pin x): "
+              "both readings are in the table's figures.", ""]
+    lines += ["## Model notes", ""]
+    lines += [f"- {note}" for note in MODEL_NOTES]
+    lines += ["", "## Findings", ""]
+    lines += [f"- {finding}" for finding in report.findings]
+    large = [row for row in report.rows if not math.isnan(row.difference())
+             and abs(row.difference()) > EXPLAIN_ABOVE and "sensitivity" not in row.note]
+    if large:
+        lines += ["", "## Differences above 10 %", ""]
+        lines += [f"- {row.quantity}: {100 * row.difference():+.1f} %. What we believe causes "
+                  f"it: {difference_cause(row.quantity)}" for row in large]
+    lines += ["", "## Runs", "",
+              "| run | scene | status | steps | stepping [s] | unconverged steps | "
+              "max penetration [mm] |",
+              "|---|---|---|---|---|---|---|"]
+    for key, run in report.runs.items():
+        unconverged = run.unconverged
+        listed = ", ".join(str(k) for k in unconverged[:5]) + (" ..." if len(unconverged) > 5
+                                                              else "")
+        lines.append(f"| {key} | {run.scene.name} | {run.trajectory.status.value} | "
+                     f"{run.trajectory.steps} | "
+                     f"{run.trajectory.stepping_seconds:.0f} | {len(unconverged)}"
+                     f"{' (' + listed + ')' if unconverged else ''} | {run.penetration:.2e} |")
+    if figures:
+        lines += ["", "## Figures", ""]
+        for title, figure in figures.items():
+            relative = Path("figures") / figure.name
+            lines.append(f"![{title}]({relative.as_posix()})")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text("\n".join(lines) + "\n")
+
+
+def _number(value) -> float | None:
+    return None if value is None or (isinstance(value, float) and math.isnan(value)) \
+        else float(value)
+
+
+def write_json(report: ValidationReport, path: Path, figures: dict[str, Path],
+               preset: str) -> None:
+    """The table, findings, runs and figure files as JSON, for the comparison report
+    (:mod:`clearbench.harness.report.page` shows it as its C-60 section). Figure paths are
+    relative to ``path``'s directory; NaN (no published figure) is null."""
+    import json
+
+    base = path.parent.resolve()
+    document = {
+        "title": "C-60: the reference engine against the published figures",
+        "source": "clearbench c60 validate",
+        "preset": preset,
+        "paper": "Akhadkar, Acary, Brogliato, Multibody System Dynamics 42(3), 2018, "
+                 "Sections 4.2 and 5",
+        "rows": [{"quantity": row.quantity, "unit": row.unit, "ours": _number(row.ours),
+                  "paper_simulated": _number(row.paper_simulated),
+                  "paper_measured": _number(row.paper_measured),
+                  "difference": _number(row.difference()), "note": row.note,
+                  "believed_cause": difference_cause(row.quantity)
+                  if abs(_number(row.difference()) or 0.0) > EXPLAIN_ABOVE else None}
+                 for row in report.rows],
+        "findings": list(report.findings),
+        "runs": [{"key": key, "scene": run.scene.name, "steps": run.trajectory.steps,
+                  "stepping_seconds": run.trajectory.stepping_seconds,
+                  "status": run.trajectory.status.value, "message": run.trajectory.message,
+                  "unconverged_steps": len(run.unconverged),
+                  "unconverged_projections": len(
+                      run.trajectory.metadata.get("unconverged_projections", [])),
+                  "max_penetration_mm": run.penetration}
+                 for key, run in report.runs.items()],
+        "figures": {title: Path(figure).resolve().relative_to(base).as_posix()
+                    if Path(figure).resolve().is_relative_to(base) else str(figure)
+                    for title, figure in figures.items()},
+    }
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(document, indent=1) + "\n")
+
+
+def write_figures(report: ValidationReport, directory: Path) -> dict[str, Path]:
+    """Force-displacement figures of the bench tests (PNG), with the paper's key points."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    directory.mkdir(parents=True, exist_ok=True)
+    experiments = _paper()["experiments"]
+    out = {}
+    curves = report.curves.get("trip_force", {})
+    if curves:
+        figure, axes = plt.subplots(figsize=(6.5, 4.2))
+        for label, curve in curves.items():
+            axes.plot(curve.displacement, curve.force, label=f"ours, {label}")
+        peak = experiments["trip_test_peak_force_N"]
+        distance = experiments["trip_test_total_distance_mm"]
+        axes.plot([experiments["trip_test_peak_at_mm"]], [peak["measured"]], "ks",
+                  label="paper, measured peak")
+        axes.axvline(distance["measured"], color="k", ls=":", label="paper, measured trip")
+        axes.axvline(distance["simulated"], color="grey", ls="--",
+                     label="paper, simulated trip")
+        axes.axhline(peak["simulated"], color="grey", ls="-.", label="paper, simulated peak")
+        axes.set_xlabel("probe displacement since first contact [mm]")
+        axes.set_ylabel("probe force [N]")
+        axes.set_title("C-60 trip test, pin side (prototype clearances)")
+        axes.legend(fontsize=7)
+        path = directory / "c60_trip_force.png"
+        figure.tight_layout()
+        figure.savefig(path, dpi=110)
+        plt.close(figure)
+        out["Trip force vs displacement"] = path
+    curves = report.curves.get("contact_force", {})
+    if curves:
+        figure, axes = plt.subplots(figsize=(6.5, 4.2))
+        for label, curve in curves.items():
+            axes.plot(curve.forward_displacement, curve.forward_force,
+                      label=f"ours, {label}, forward")
+            axes.plot(curve.backward_displacement, curve.backward_force, ls="--",
+                      label=f"ours, {label}, backward")
+        force = experiments["contact_force_at_equilibrium_N"]
+        axes.plot([experiments["contact_test_total_displacement_mm"]], [force["measured"]],
+                  "ks", label="paper, measured at equilibrium")
+        axes.axhline(force["simulated"], color="grey", ls="-.", label="paper, simulated")
+        axes.set_xlabel("probe displacement since first load [mm]")
+        axes.set_ylabel("contact force [N]")
+        axes.set_title("C-60 contact-force test (prototype clearances)")
+        axes.legend(fontsize=7)
+        path = directory / "c60_contact_force.png"
+        figure.tight_layout()
+        figure.savefig(path, dpi=110)
+        plt.close(figure)
+        out["Contact force vs displacement"] = path
+    return out
+
+
+def _trip_failure(run: Run) -> str:
+    """What did not converge in the run and the largest penetration, where and when."""
+    trajectory = run.trajectory
+    projections = list(trajectory.metadata.get("unconverged_projections", []))
+    depth = metrics.penetration(run.scene, trajectory)
+    text = (f"c60-trip: {len(run.unconverged)} of {trajectory.steps} steps whose contact "
+            f"problem did not converge {run.unconverged[:5]}, {len(projections)} whose "
+            f"projection did not reach its tolerance {projections[:5]}")
+    if depth.size:
+        sample, pair = np.unravel_index(int(np.argmax(depth)), depth.shape)
+        text += (f"; largest penetration over the recorded states {depth.max():.2e} mm "
+                 f"({trajectory.contact_names[pair]}, t = {trajectory.times[sample]:.3f} ms)")
+    return text + "."

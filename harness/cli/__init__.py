@@ -1,0 +1,1 @@
+"""The ``clearbench`` command line: one module per command, assembled by :mod:`.main`."""

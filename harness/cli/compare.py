@@ -1,0 +1,107 @@
+"""``clearbench compare``: the default comparison (the README's main job) and its report."""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+from clearbench.harness.cli.common import (
+    add_runner_options,
+    engine_modules,
+    make_runner,
+    open_store,
+)
+from clearbench.harness.cli.main import UserError
+from clearbench.harness.cli.sweep import print_work_precision
+from clearbench.harness.report.page import write_report
+from clearbench.harness.run.engine_choice import RunInputError, resolve_engine
+from clearbench.harness.studies.stability import available_engines, plan_stability
+from clearbench.harness.studies.sweep import (
+    FINE_FACTOR,
+    REFERENCE_ENGINE,
+    execute_plan,
+    parse_ladder,
+    plan_sweep,
+)
+from clearbench.scenarios.library import scene_names
+
+#: Scenes of the default comparison: the library scenes with these tags.
+COMPARE_TAGS = ("smoke", "analytic")
+#: Default ladder of the comparison: the comfortable step and its half.
+COMPARE_LADDER = "1x,0.5x"
+
+
+def compare_scenes() -> list[str]:
+    """Registered scenes with a tag of :data:`COMPARE_TAGS`, not in the stiff suite."""
+    chosen = []
+    for tag in COMPARE_TAGS:
+        chosen += [n for n in scene_names(tag) if n not in chosen]
+    stiff = set(scene_names("stiff"))
+    return [n for n in chosen if n not in stiff]
+
+
+def register(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "compare", help="the default comparison of the available engines, and its report",
+        description="Run the default comparison: every available engine (reference, and "
+        "MuJoCo etc. where available) on the library scenes tagged "
+        f"{' or '.join(COMPARE_TAGS)} at their comfortable step and a short ladder "
+        f"({COMPARE_LADDER}), optionally the stiff suite, then write the report. Runs already "
+        "in the store are reused.",
+    )
+    add_compare_options(parser)
+    parser.set_defaults(handler=run_compare)
+
+
+def add_compare_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--engines", "-e", nargs="+", default=None, metavar="ENGINE[PRESET]",
+                        help="engines (default: every available engine, default preset)")
+    parser.add_argument("--scenes", nargs="+", default=None, metavar="SCENE",
+                        help="scenes (default: the library scenes tagged "
+                        f"{', '.join(COMPARE_TAGS)})")
+    parser.add_argument("--dt", default=COMPARE_LADDER, metavar="LADDER",
+                        help=f"time-step ladder (default {COMPARE_LADDER})")
+    parser.add_argument("--stability", action="store_true",
+                        help="also run the stiff and extreme suite")
+    parser.add_argument("--out", default="reports/out", metavar="DIR",
+                        help="report directory (default reports/out)")
+    add_runner_options(parser, timeout=300.0)
+
+
+def run_compare(args: argparse.Namespace) -> int:
+    start = time.monotonic()
+    modules = engine_modules(args)
+    try:
+        engines = ([resolve_engine(e, modules, field="--engines") for e in args.engines]
+                   if args.engines else available_engines(modules))
+        if not engines:
+            raise UserError("no engine is available here (see `clearbench list`)")
+        reference = None
+        try:
+            reference = resolve_engine(REFERENCE_ENGINE, modules)
+        except RunInputError as error:
+            print(f"note: no fine reference runs: {error}")
+        scenes = args.scenes or compare_scenes()
+        plan = plan_sweep(scenes, engines, parse_ladder(args.dt), timeout=args.timeout,
+                          reference=reference, fine_factor=FINE_FACTOR, campaign="compare")
+        stiff = plan_stability(engines, timeout=args.timeout) if args.stability else []
+    except RunInputError as error:
+        raise UserError(str(error)) from None
+    store = open_store(args)
+    labels = ", ".join(e.label for e in engines)
+    print(f"Comparing {labels} on {len(scenes)} scenes (ladder {args.dt}"
+          + (", and the stiff suite" if stiff else "") + f"), store {store.directory}")
+    runner = make_runner(args, store, len(plan.all_specs) + len(stiff))
+    outcome = execute_plan(plan, runner)
+    if stiff:
+        more = runner.run_all(stiff)
+        outcome.ran += more.ran
+        outcome.skipped += more.skipped
+    print(f"{len(outcome.ran)} runs done, {len(outcome.skipped)} reused from the store, "
+          f"{time.monotonic() - start:.0f} s")
+    print_work_precision(store, [s.scene.name for s in plan.all_specs],
+                         {s.key for s in plan.all_specs})
+    paths = write_report(store, args.out)
+    print(f"\nreport: {paths['html']}\nsummary: {paths['markdown']} "
+          f"({time.monotonic() - start:.0f} s in all)")
+    return 0

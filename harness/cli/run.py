@@ -1,0 +1,113 @@
+"""``clearbench run``: one scene in one engine, isolated in a worker, stored, summarised."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shutil
+
+from clearbench.harness.cli.common import (
+    add_runner_options,
+    assignments,
+    engine_modules,
+    make_runner,
+    open_store,
+)
+from clearbench.harness.cli.main import UserError
+from clearbench.harness.measure.headline import format_value
+from clearbench.harness.run.engine_choice import RunInputError
+from clearbench.harness.run.spec import make_run_spec
+
+
+def register(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "run", help="run one scene in one engine and print its metrics",
+        description="Run SCENE (a registered name or a .toml/.json scene file) in one engine, in "
+        "an isolated worker process with a wall-clock limit, record it in the results store "
+        "and print its metrics, expectations and verdict. A run already in the store is shown "
+        "from the store (--rerun to run it again).",
+    )
+    parser.add_argument("scene", help="registered scene name or scene file")
+    parser.add_argument("--engine", "-e", default="reference", metavar="ENGINE[PRESET]",
+                        help="engine and preset, e.g. reference, mujoco[elliptic] "
+                        "(default: reference)")
+    parser.add_argument("--dt", type=float, default=None,
+                        help="time step in the scene's time unit (default: the scene's)")
+    parser.add_argument("--horizon", type=float, default=None,
+                        help="simulated duration in the scene's time unit (default: the scene's)")
+    parser.add_argument("--record-every", type=int, default=1, metavar="N",
+                        help="keep one sample every N steps (default 1)")
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help="a parameter of the scene's factory, e.g. radial_clearance=1e-5")
+    parser.add_argument("--option", action="append", default=[], metavar="KEY=VALUE",
+                        help="an engine option overriding the preset, e.g. tolerance=1e-10")
+    parser.add_argument("--out", metavar="FILE.npz", help="also write the trajectory here")
+    parser.add_argument("--json", action="store_true", help="print the stored row as JSON")
+    add_runner_options(parser)
+    parser.set_defaults(handler=run_one)
+
+
+def run_one(args: argparse.Namespace) -> int:
+    try:
+        spec = make_run_spec(args.scene, args.engine,
+                             scene_parameters=assignments(args.set, "--set"),
+                             time_step=args.dt, horizon=args.horizon,
+                             record_every=args.record_every,
+                             options=assignments(args.option, "--option"),
+                             timeout=args.timeout, extra_engine_modules=engine_modules(args),
+                             campaign="run")
+    except RunInputError as error:
+        raise UserError(str(error)) from None
+    store = open_store(args)
+    runner = make_runner(args, store, 1)
+    outcome = runner.run_all([spec], rerun=args.rerun)
+    row = store.get(spec.key)
+    if row is None:  # pragma: no cover - the runner always records
+        raise UserError(f"run {spec.key} was not recorded")
+    if args.out:
+        trajectory = store.trajectory_path(spec.key)
+        if not trajectory.exists():
+            raise UserError(f"--out {args.out}: run ended {row['status']} with no trajectory")
+        shutil.copyfile(trajectory, args.out)
+    if args.json:
+        print(json.dumps(row, indent=2, sort_keys=True))
+    else:
+        print_summary(row, from_store=spec.key in outcome.skipped, store_path=store.directory)
+    return 0 if row["status"] in ("ok", "unsupported") else 1
+
+
+def print_summary(row: dict, from_store: bool = False, store_path=None) -> None:
+    """Human-readable summary of one stored run."""
+    origin = " (from the store; --rerun to run again)" if from_store else ""
+    print(f"{row['scene_name']}  {row['engine']}[{row['preset']}]  dt = {row['time_step']:g}  "
+          f"horizon = {row['horizon']:g}{origin}")
+    print(f"  status: {row['status']}" + (f" — {row['message']}" if row["message"] else ""))
+    if row["engine_status"] != row["status"]:
+        print(f"  engine reported: {row['engine_status']} {row['engine_message']}".rstrip())
+    print(f"  engine: {row['engine_version']}")
+    print(f"  wall: worker {format_value(row['worker_seconds'], 's')}, build "
+          f"{format_value(row['build_seconds'], 's')}, stepping "
+          f"{format_value(row['stepping_seconds'], 's')} for {row['steps']} steps "
+          f"({format_value(row['stepping_seconds_per_step'], 's')}/step, "
+          f"{format_value(row['stepping_seconds_per_simulated_second'], 's')} per simulated "
+          "time unit)")
+    figures = json.loads(row["metrics"] or "{}")
+    if figures:
+        print("  metrics (scene units):")
+        for name in sorted(figures):
+            print(f"    {name:<36} {format_value(figures[name])}")
+    if row["error_source"]:
+        print(f"  error measured against: {row['error_source']}")
+    expectations = json.loads(row["expectations"] or "[]")
+    if expectations:
+        print("  expectations:")
+        for result in expectations:
+            passed = result.get("passed")
+            mark = {True: "pass", False: "FAIL", None: "n/a"}.get(passed, str(passed))
+            detail = result.get("message") or result.get("statement") or ""
+            print(f"    {mark:<5} {result.get('name', result.get('kind', '?'))}: {detail}")
+    if row["metrics_error"]:
+        print(f"  metrics not computed: {row['metrics_error']}")
+    if row["trajectory"] and store_path is not None:
+        print(f"  trajectory: {store_path / row['trajectory']}")
+    print(f"  run key: {row['key']}")

@@ -1,0 +1,144 @@
+"""Scene sub-commands: ``list``, ``show``, ``validate`` and ``demo``."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import textwrap
+
+from clearbench.adapters.registry import all_availability
+from clearbench.harness.cli.main import UserError
+from clearbench.scenarios.library import SCENES, get_entry, scene_names
+from clearbench.scenarios.serialization import (
+    load_scene_file,
+    scene_from_dict,
+    scene_to_dict,
+    scene_to_json,
+    scene_to_toml,
+)
+from clearbench.scenarios.units import LENGTH_UNITS, MASS_UNITS, TIME_UNITS, UnitSystem
+from clearbench.scenarios.validation import SceneError
+
+
+def register(subparsers) -> None:
+    """Add the scene sub-commands to ``subparsers``."""
+    listing = subparsers.add_parser(
+        "list", help="list the registered scenes (tags, features) and the engines",
+        description="List every registered scene with its tags and derived features, and every "
+        "engine with its availability on this machine.",
+    )
+    listing.add_argument("--tag", help="only scenes with this tag")
+    listing.set_defaults(handler=run_list)
+
+    show = subparsers.add_parser(
+        "show", help="print a scene in TOML or JSON",
+        description="Print a registered scene as a TOML (default) or JSON scene file.",
+    )
+    show.add_argument("scene", help="registered scene name (see `clearbench list`)")
+    show.add_argument("--format", choices=("toml", "json"), default="toml")
+    show.add_argument("--units", metavar="L-M-T",
+                      help="rescale to another unit system first, e.g. mm-g-ms")
+    show.set_defaults(handler=run_show)
+
+    validate = subparsers.add_parser(
+        "validate", help="validate a scene file (TOML or JSON)",
+        description="Read a scene file, validate every field and cross reference, and check "
+        "that it round-trips losslessly. Exit status 0 when valid, 2 with the field and value "
+        "at fault otherwise.",
+    )
+    validate.add_argument("file", help="scene file (.toml or .json)")
+    validate.set_defaults(handler=run_validate)
+
+    demo = subparsers.add_parser(
+        "demo", help="the README's main job: validate the scenes, run the comparison, report",
+        description="The main job: validate every registered scene, list the engines, then run "
+        "the default comparison of the available engines (`clearbench compare`) and write the "
+        "report. Takes the options of `compare`.",
+    )
+    from clearbench.harness.cli.compare import add_compare_options
+
+    add_compare_options(demo)
+    demo.set_defaults(handler=run_demo)
+
+
+def parse_units(text: str) -> UnitSystem:
+    """``'mm-g-ms'`` -> UnitSystem; UserError naming the accepted units otherwise."""
+    parts = text.split("-")
+    if len(parts) != 3:
+        raise UserError(f"--units {text!r}: expected LENGTH-MASS-TIME, e.g. mm-g-ms")
+    try:
+        return UnitSystem(*parts)
+    except SceneError as error:
+        raise UserError(
+            f"--units {text!r}: {error} (length {sorted(LENGTH_UNITS)}, mass "
+            f"{sorted(MASS_UNITS)}, time {sorted(TIME_UNITS)})"
+        ) from None
+
+
+def run_list(args: argparse.Namespace) -> int:
+    names = scene_names(args.tag)
+    if args.tag and not names:
+        tags = sorted({t for e in SCENES.values() for t in e.tags})
+        raise UserError(f"no scene has tag {args.tag!r}; tags: {', '.join(tags)}")
+    print(f"Scenes ({len(names)}):")
+    for name in names:
+        entry = get_entry(name)
+        scene = entry.build()
+        print(f"  {name:<22} {entry.summary}")
+        print(f"  {'':<22} tags: {', '.join(entry.tags)}")
+        features = ", ".join(sorted(scene.features)) or "(none)"
+        for line in textwrap.wrap(f"features: {features}", 74):
+            print(f"  {'':<22} {line}")
+    print("\nEngines:")
+    for availability in all_availability():
+        state = "available" if availability.available else "unavailable"
+        print(f"  {availability.engine:<10} {state:<12} {availability.detail}")
+    return 0
+
+
+def run_show(args: argparse.Namespace) -> int:
+    try:
+        scene = get_entry(args.scene).build()
+    except KeyError as error:
+        raise UserError(str(error.args[0])) from None
+    if args.units:
+        scene = scene.rescaled(parse_units(args.units))
+    sys.stdout.write(scene_to_toml(scene) if args.format == "toml" else scene_to_json(scene))
+    if args.format == "json":
+        sys.stdout.write("\n")
+    return 0
+
+
+def run_validate(args: argparse.Namespace) -> int:
+    try:
+        scene = load_scene_file(args.file)
+    except FileNotFoundError:
+        raise UserError(f"{args.file}: no such file") from None
+    except SceneError as error:
+        raise UserError(f"{args.file}: invalid scene: {error}") from None
+    again = scene_from_dict(scene_to_dict(scene))
+    if again != scene:
+        raise UserError(f"{args.file}: the scene does not round-trip losslessly (a bug)")
+    print(f"{args.file}: valid scene {scene.name!r} in {scene.units.describe()}: "
+          f"{len(scene.bodies)} bodies, {len(scene.joints)} joints, "
+          f"{len(scene.clearance_joints)} clearance joints, {len(scene.all_contacts)} contact "
+          f"pairs, horizon {scene.horizon} {scene.units.time}")
+    print(f"  features: {', '.join(sorted(scene.features)) or '(none)'}")
+    return 0
+
+
+def run_demo(args: argparse.Namespace) -> int:
+    print("Validating every registered scene (build, lossless round trip, mm-g-ms rescale):")
+    for name in scene_names():
+        scene = get_entry(name).build()
+        assert scene_from_dict(scene_to_dict(scene)) == scene
+        print(f"  ok  {name:<22} {len(scene.bodies)} bodies, {len(scene.all_contacts)} "
+              f"contact pairs, horizon {scene.horizon} {scene.units.time}")
+    print("\nEngines:")
+    for availability in all_availability():
+        state = "available" if availability.available else "unavailable"
+        print(f"  {availability.engine:<10} {state:<12} {availability.detail}")
+    print()
+    from clearbench.harness.cli.compare import run_compare
+
+    return run_compare(args)

@@ -1,0 +1,70 @@
+"""``clearbench stability``: the stiff and extreme suite, each engine's verdict per case."""
+
+from __future__ import annotations
+
+import argparse
+
+from clearbench.harness.cli.common import (
+    add_runner_options,
+    engine_modules,
+    make_runner,
+    open_store,
+)
+from clearbench.harness.cli.main import UserError
+from clearbench.harness.measure.headline import METRIC_LABELS, format_value
+from clearbench.harness.run.engine_choice import RunInputError
+from clearbench.harness.studies.stability import (
+    STIFF_TAG,
+    available_engines,
+    plan_stability,
+    stability_rows,
+)
+from clearbench.harness.studies.sweep import resolve_engines
+
+
+def register(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "stability", help="the stiff and extreme suite: verdict and metrics per engine",
+        description="Run every scene tagged 'stiff' (tight clearances, mass ratio 1e4, stiff "
+        "springs, 10x steps, tunnelling impacts, mu = 2, e = 1, 100+ contacts, millimetre parts "
+        "in SI units) in each engine at the case's own step, and print each engine's verdict "
+        "(ok / diverged / crashed / timed_out / unsupported) with the metrics of the case.",
+    )
+    parser.add_argument("--engines", "-e", nargs="+", default=None, metavar="ENGINE[PRESET]",
+                        help="engines (default: every available engine, default preset)")
+    parser.add_argument("--scenes", nargs="+", default=None, metavar="SCENE",
+                        help=f"only these cases (default: every scene tagged {STIFF_TAG!r})")
+    add_runner_options(parser, timeout=300.0)
+    parser.set_defaults(handler=run_stability)
+
+
+def run_stability(args: argparse.Namespace) -> int:
+    modules = engine_modules(args)
+    try:
+        engines = (resolve_engines(args.engines, modules) if args.engines
+                   else available_engines(modules))
+        if not engines:
+            raise UserError("no engine is available here (see `clearbench list`)")
+        specs = plan_stability(engines, args.scenes, timeout=args.timeout)
+    except RunInputError as error:
+        raise UserError(str(error)) from None
+    store = open_store(args)
+    runner = make_runner(args, store, len(specs))
+    outcome = runner.run_all(specs, rerun=args.rerun)
+    print(f"{len(outcome.ran)} runs done, {len(outcome.skipped)} already in {store.directory}")
+    rows = stability_rows(store.dataframe(), specs)
+    case = None
+    for row in rows:
+        if row["case"] != case:
+            case = row["case"]
+            print(f"\n{case}: {row['summary']}")
+        passed = {1: "expectations pass", 0: "expectation FAILED"}.get(
+            row["expectations_passed"], "")
+        figures = ", ".join(f"{METRIC_LABELS.get(n, (n,))[0]} {format_value(v)}"
+                            for n, v in row["metrics"].items())
+        print(f"  {row['engine']:<24} {row['status']:<11} {passed}")
+        if row["reason"] and row["status"] != "ok":
+            print(f"  {'':<24} {row['reason']}")
+        if figures:
+            print(f"  {'':<24} {figures}")
+    return 0

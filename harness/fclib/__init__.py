@@ -1,0 +1,1 @@
+"""FCLIB one-step contact problems: reading them, and our solvers against Siconos's."""

@@ -1,0 +1,343 @@
+"""The figures of one run: drift, stiction, energy, error, solver statistics, and the verdict.
+
+Computed from the trajectory and the scene with the shared metrics (:mod:`.metrics`) and the
+expectations (:mod:`.expectations`), never from an engine's own report. Every figure is a float
+in the scene's units (named below); a figure that does not apply to the scene is absent.
+
+=======================================  =====================================================
+``penetration_max``                      max over pairs and samples of max(0, -gap) [L]
+``penetration_relative``                 the same over the smallest feature of its pair [-]
+``clearance_eccentricity_max``           largest eccentricity in a clearance joint [L]
+``clearance_excess_max``                 eccentricity beyond the radial clearance [L]
+``clearance_excess_relative``            the same over the radial clearance [-]
+``joint_distance_max``                   ideal-joint anchor separation [L]
+``joint_angle_max``                      ideal-joint axis / orientation violation [rad]
+``quaternion_norm_error_max``            max | |p| - 1 | as returned by the engine [-]
+``stiction_displacement``                largest displacement of a body that must stick [L]
+``stiction_creep_rate``                  its mean creep rate (least-squares slope) [L/T]
+``energy_scale``                         energy the run is judged against [M L^2/T^2]
+``energy_drift``                         max |E - E0| / energy_scale [-]
+``energy_growth``                        max rise of E above its running minimum / scale [-]
+``output_error.NAME``                    max |y - y_ref| on named output NAME [its unit]
+``error``                                headline error (relative): analytic where the scene
+                                         has an analytic reference (see judgement.py), else the
+                                         largest relative output error against the reference
+                                         trajectory [-]
+``EXPECTATION.FIGURE``                   every figure of every expectation (expectations.py)
+``solver_unconverged_steps``             recorded steps whose one-step problem did not converge
+``solver_residual_max``                  largest recorded residual (engine's measure) [-]
+``solver_iterations_mean``               mean recorded iterations
+=======================================  =====================================================
+
+Verdict (for a run the engine finished): ``diverged`` when a value is not finite, when energy
+that may not grow grows by more than :data:`ENERGY_GROWTH_LIMIT` of its scale, when a body
+escapes (:data:`ESCAPE_FACTOR`), when a journal leaves its bore (excess beyond
+:data:`BORE_ESCAPE_FACTOR` clearances) or when a penetration exceeds the smallest feature of its
+pair (tunnelling); ``ok`` otherwise.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from clearbench.adapters.trajectory import RunStatus, Trajectory
+from clearbench.scenarios.bodies import Motion
+from clearbench.scenarios.scene import Scene
+
+LOG = logging.getLogger(__name__)
+
+#: Energy growth beyond this fraction of the energy scale is a diverged run.
+ENERGY_GROWTH_LIMIT = 0.1
+#: A body farther than this many scene sizes (plus free-flight reach) from its start escaped.
+ESCAPE_FACTOR = 100.0
+#: A clearance-joint excess beyond this many radial clearances means the journal left its bore.
+BORE_ESCAPE_FACTOR = 10.0
+#: Expectation kinds whose body must not move.
+STICK_KINDS = frozenset({"incline_stick", "sticks"})
+#: Features whose loads do work the energy balance does not count.
+WORKING_FEATURES = frozenset({"drivers", "point_forces", "moments"})
+
+
+@dataclass(frozen=True)
+class Measurement:
+    """Figures of one run (see the module docstring for names and units)."""
+
+    figures: dict
+    expectations: tuple
+    verdict: RunStatus
+    verdict_reason: str = ""
+    error_source: str = ""
+    metrics_error: str = ""
+
+
+def has_analytic_reference(scene: Scene) -> bool:
+    """True when an expectation of the scene has an analytic solution to measure error by."""
+    from clearbench.harness.measure.verdicts import ANALYTIC_ERROR
+
+    return any(e.kind in ANALYTIC_ERROR for e in scene.expectations)
+
+
+def first_non_finite(trajectory: Trajectory) -> str | None:
+    """Where the trajectory first holds a non-finite value, as a message; None if nowhere."""
+    for name in ("positions", "orientations", "velocities", "angular_velocities",
+                 "contact_normal_force", "contact_force"):
+        values = np.asarray(getattr(trajectory, name), dtype=float)
+        if values.size == 0:
+            continue
+        bad = ~np.isfinite(values.reshape(len(values), -1)).all(axis=1)
+        if bad.any():
+            k = int(np.argmax(bad))
+            t = trajectory.times[k] if k < len(trajectory.times) else float("nan")
+            return f"non-finite {name} at t = {t:.6g} (sample {k})"
+    if len(trajectory.times) and not np.isfinite(trajectory.times).all():
+        return "non-finite sample times"
+    return None
+
+
+def shape_size(shape) -> float:
+    """Smallest characteristic size of a shape [L] (inf for a half-space)."""
+    if hasattr(shape, "half_extents"):
+        return float(min(shape.half_extents))
+    if hasattr(shape, "radius"):
+        return float(shape.radius)
+    return math.inf
+
+
+def _body_size(body) -> float:
+    from clearbench.harness.measure import series as metrics
+
+    return metrics.body_size(body)
+
+
+def scene_size(scene: Scene) -> float:
+    """Length scale of the scene's initial configuration [L] (> 0)."""
+    positions = np.array([b.position for b in scene.bodies], dtype=float)
+    spread = float(np.max(np.ptp(positions, axis=0))) if len(positions) > 1 else 0.0
+    size = max([spread] + [_body_size(b) for b in scene.bodies])
+    return size if size > 0 else 1.0
+
+
+def _expectation_results(scene: Scene, trajectory: Trajectory, out: _Collector):
+    """Every expectation's figures (also flattened into ``NAME.FIGURE`` figures), pass/fail
+    and criterion (:mod:`.judgement`), and the analytic error with its source."""
+    from clearbench.harness.measure.expectation_figures import evaluate
+    from clearbench.harness.measure.verdicts import analytic_error, judge
+
+    bodies = {e.name: e.body for e in scene.expectations}
+    results = []
+    errors = []
+    for result in evaluate(scene, trajectory):
+        figures = {k: float(v) for k, v in result.figures.items()}
+        passed, criterion = judge(scene, result.kind, bodies.get(result.name), figures)
+        results.append({"name": result.name, "kind": result.kind, "figures": figures,
+                        "headline": result.headline, "note": result.note, "passed": passed,
+                        "criterion": criterion})
+        for key, value in figures.items():
+            out.put(f"{result.name}.{key}", value)
+        error = analytic_error(result.kind, figures)
+        if math.isfinite(error):
+            errors.append((error, result.name))
+    if not errors:
+        return results, math.nan, ""
+    value, name = max(errors)
+    return results, value, f"analytic ({name})"
+
+
+class _Collector:
+    def __init__(self):
+        self.figures: dict[str, float] = {}
+        self.errors: list[str] = []
+
+    def put(self, name: str, value) -> None:
+        self.figures[name] = float(value)
+
+    def guard(self, group: str):
+        collector = self
+
+        class _Guard:
+            def __enter__(self):
+                return self
+
+            def __exit__(self, kind, error, tb):
+                if error is not None and isinstance(error, Exception):
+                    LOG.debug("metric group %s failed", group, exc_info=True)
+                    collector.errors.append(f"{group}: {type(error).__name__}: {error}")
+                    return True
+                return False
+
+        return _Guard()
+
+
+def _solver_figures(trajectory: Trajectory, out: _Collector) -> None:
+    if len(trajectory.times) == 0:
+        return
+    converged = np.asarray(trajectory.solver_converged, dtype=bool)
+    out.put("solver_unconverged_steps", int(np.count_nonzero(~converged[1:])))
+    residual = np.asarray(trajectory.solver_residual, dtype=float)
+    if np.isfinite(residual).any():
+        out.put("solver_residual_max", float(np.nanmax(residual)))
+    out.put("solver_iterations_mean", float(np.mean(trajectory.solver_iterations)))
+
+
+def measure(scene: Scene, trajectory: Trajectory, reference: Trajectory | None = None,
+            reference_label: str = "reference trajectory") -> Measurement:
+    """Every figure of one run, its expectations and its verdict.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene the engine was given.
+    trajectory : Trajectory
+        What the engine returned.
+    reference : Trajectory, optional
+        The same scene by the reference solver at a fine step; the run's named outputs are
+        compared with it where the scene has no analytic reference.
+    """
+    out = _Collector()
+    _solver_figures(trajectory, out)
+    status = trajectory.status
+    if status is not RunStatus.OK or len(trajectory.times) == 0:
+        return Measurement(out.figures, (), status, trajectory.message)
+    try:
+        from clearbench.harness.measure import series as metrics
+    except ImportError as error:
+        return Measurement(out.figures, (), status, "",
+                           metrics_error=f"metrics unavailable: {error}")
+    reasons: list[str] = []
+
+    with out.guard("drift"):
+        _drift(scene, trajectory, metrics, out, reasons)
+    with out.guard("stiction"):
+        _stiction(scene, trajectory, metrics, out)
+    with out.guard("energy"):
+        _energy(scene, trajectory, metrics, out, reasons)
+    with out.guard("escape"):
+        _escape(scene, trajectory, metrics, reasons)
+
+    results: list[dict] = []
+    error, source = math.nan, ""
+    with out.guard("expectations"):
+        results, error, source = _expectation_results(scene, trajectory, out)
+    if math.isnan(error) and reference is not None and scene.outputs:
+        with out.guard("reference error"):
+            error = _output_error(scene, trajectory, reference, metrics, out)
+            source = reference_label if math.isfinite(error) else ""
+    if math.isfinite(error):
+        out.put("error", error)
+    verdict = RunStatus.DIVERGED if reasons else RunStatus.OK
+    return Measurement(out.figures, tuple(results), verdict, "; ".join(reasons), source,
+                       "; ".join(out.errors))
+
+
+def _drift(scene, trajectory, metrics, out: _Collector, reasons: list[str]) -> None:
+    out.put("quaternion_norm_error_max", np.max(metrics.quaternion_norm_error(trajectory)))
+    contacts = scene.expanded.contacts
+    if contacts:
+        depth = metrics.penetration(scene, trajectory)
+        out.put("penetration_max", np.max(depth))
+        shapes = {(b.name, s.name): s for b in scene.expanded.bodies for s in b.shapes}
+        feature = np.array([min(shape_size(shapes[(c.body_a, c.shape_a)]),
+                                shape_size(shapes[(c.body_b, c.shape_b)])) for c in contacts])
+        relative = np.max(depth, axis=0) / feature
+        out.put("penetration_relative", np.max(relative))
+        worst = int(np.argmax(relative))
+        if relative[worst] > 1.0:
+            reasons.append(f"penetration {np.max(depth[:, worst]):.3g} in {contacts[worst].name}"
+                           f" exceeds its smallest feature {feature[worst]:.3g} (tunnelled)")
+    if scene.clearance_joints:
+        motion = metrics.clearance_motion(scene, trajectory)
+        out.put("clearance_eccentricity_max", np.max(motion.eccentricity))
+        out.put("clearance_excess_max", np.max(motion.excess))
+        radial = np.array([j.radial_clearance for j in scene.clearance_joints])
+        relative = np.max(motion.excess, axis=0) / radial
+        out.put("clearance_excess_relative", np.max(relative))
+        worst = int(np.argmax(relative))
+        if relative[worst] > BORE_ESCAPE_FACTOR:
+            reasons.append(f"journal of {motion.names[worst]} left its bore (excess "
+                           f"{relative[worst]:.3g} radial clearances)")
+    if scene.joints:
+        violation = metrics.joint_violation(scene, trajectory)
+        out.put("joint_distance_max", np.max(violation.distance))
+        out.put("joint_angle_max", np.max(violation.angle))
+
+
+def _stiction(scene, trajectory, metrics, out: _Collector) -> None:
+    worst = None
+    for expectation in scene.expectations:
+        if expectation.kind not in STICK_KINDS:
+            continue
+        start = float(expectation.parameters.get("start_time", 0.0))
+        end = expectation.parameters.get("end_time")
+        result = metrics.stiction(scene, trajectory, expectation.body, start,
+                                  None if end is None else float(end))
+        if worst is None or result.displacement > worst.displacement:
+            worst = result
+    if worst is not None:
+        out.put("stiction_displacement", worst.displacement)
+        out.put("stiction_creep_rate", worst.creep_rate)
+
+
+def energy_scale(scene: Scene, energy) -> float:
+    """The shared energy scale (:func:`clearbench.harness.measure.series.energy_scale`)."""
+    from clearbench.harness.measure import series as metrics
+
+    return metrics.energy_scale(scene, energy)
+
+
+def _energy(scene, trajectory, metrics, out: _Collector, reasons: list[str]) -> None:
+    if scene.features & WORKING_FEATURES:
+        return
+    energy = metrics.energy(scene, trajectory)
+    total = energy.total
+    scale = energy_scale(scene, energy)
+    out.put("energy_scale", scale)
+    out.put("energy_drift", np.max(np.abs(total - total[0])) / scale)
+    rise, rise_scale = metrics.energy_growth(scene, trajectory, energy)
+    growth = rise / rise_scale
+    out.put("energy_growth", growth)
+    must_not_grow = any(e.kind in ("energy_non_increasing", "energy_conserved")
+                        for e in scene.expectations)
+    if must_not_grow and growth > ENERGY_GROWTH_LIMIT:
+        reasons.append(f"energy grew by {100 * growth:.3g} % of its scale {rise_scale:.3g} "
+                       "(energy that may not grow)")
+
+
+def _escape(scene, trajectory, metrics, reasons: list[str]) -> None:
+    positions = metrics.centre_of_mass_positions(scene, trajectory)
+    moved = np.linalg.norm(positions - positions[:1], axis=2)
+    horizon = float(trajectory.times[-1] - trajectory.times[0])
+    speed = max((float(np.linalg.norm(b.velocity)) for b in scene.bodies), default=0.0)
+    reach = speed * horizon + 0.5 * float(np.linalg.norm(scene.gravity)) * horizon**2
+    limit = ESCAPE_FACTOR * scene_size(scene) + reach
+    for b, body in enumerate(scene.bodies):
+        if body.motion is Motion.FIXED:
+            continue
+        if np.max(moved[:, b]) > limit:
+            k = int(np.argmax(moved[:, b] > limit))
+            reasons.append(f"body {body.name} escaped ({moved[k, b]:.3g} from its start at "
+                           f"t = {trajectory.times[k]:.4g}, limit {limit:.3g})")
+            return
+
+
+def _output_error(scene, trajectory, reference, metrics, out: _Collector) -> float:
+    """Max |y - y_ref| per named output (reference interpolated to the run's samples, within
+    its time span); returns the largest relative to the reference's range."""
+    values = metrics.output_values(scene, trajectory)
+    expected = metrics.output_values(scene, reference)
+    t, t_ref = trajectory.times, reference.times
+    inside = (t >= t_ref[0] - 1e-12 * max(1.0, abs(t_ref[-1]))) & \
+        (t <= t_ref[-1] * (1 + 1e-12) + 1e-300)
+    worst = math.nan
+    for name, y in values.items():
+        y_ref = np.interp(t[inside], t_ref, expected[name])
+        difference = float(np.max(np.abs(y[inside] - y_ref))) if inside.any() else math.nan
+        out.put(f"output_error.{name}", difference)
+        span = float(np.ptp(expected[name])) or float(np.max(np.abs(expected[name]))) or 1.0
+        relative = difference / span
+        if math.isfinite(relative) and not relative <= worst:
+            worst = relative
+    return worst

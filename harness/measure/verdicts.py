@@ -1,0 +1,126 @@
+"""Pass/fail of each expectation in the harness's results and report, and the analytic error.
+
+:func:`clearbench.harness.measure.expectation_figures.evaluate` states figures, not verdicts:
+what is acceptable depends on the use. These are the harness's criteria (shown in the report), each
+relative to a scale of the scene so that they hold in any unit system:
+
+=========================  ============================================================
+kind                        passes when
+=========================  ============================================================
+bounce_apex                 every resolved apex within 5 % of e^(2k) h0
+incline_stick, sticks       displacement <= 1e-4 of the body's size
+incline_slide               acceleration within 2 % of g (sin - mu cos)
+sliding_stop                stop distance within 2 % of v0^2 / (2 mu g)
+rolling_transition          final speed within 2 % of 5 v0 / 7
+pendulum                    period within 1 % and energy drift <= 1 % of m g d
+torque_free                 angular momentum drift <= 1 % of |L0|
+slider_crank                slider position within 1 % of the crank length
+rocking_ratio               first-impact ratio within 5 % of 1 - 1.5 sin^2(alpha)
+approaches_ideal            clearance excess <= one radial clearance
+energy_non_increasing       energy growth <= 1 % of the energy scale
+energy_conserved            energy drift <= 1 % of the energy scale
+no_penetration              penetration <= 1 % of the smallest contact feature (radius,
+                            half-extent or radial clearance)
+=========================  ============================================================
+
+The headline error of a run where the scene has an analytic reference is the largest of
+:data:`ANALYTIC_ERROR` over its expectations (a relative number).
+"""
+
+from __future__ import annotations
+
+import math
+
+from clearbench.scenarios.scene import Scene
+
+#: kind -> figure of :mod:`.expectations` that is the run's relative error against the
+#: analytic solution (first one present is used), and the figure that normalises it if any.
+ANALYTIC_ERROR: dict[str, tuple[tuple[str, str | None], ...]] = {
+    "bounce_apex": (("apex_max_relative_error", None),),
+    "incline_slide": (("acceleration_relative_error", None),),
+    "sliding_stop": (("stop_distance_error", "expected_stop_distance"),),
+    "rolling_transition": (("final_speed_relative_error", None),),
+    "pendulum": (("period_relative_error", None), ("energy_drift", None)),
+    "torque_free": (("angular_momentum_drift", None),),
+    "slider_crank": (("slider_position_relative_error", None),),
+    "rocking_ratio": (("ratio_relative_error", None),),
+}
+
+
+def analytic_error(kind: str, figures: dict) -> float:
+    """|relative error| against the analytic solution, NaN when the kind has none or the
+    figure is missing."""
+    for name, normaliser in ANALYTIC_ERROR.get(kind, ()):
+        value = figures.get(name)
+        if value is None or not math.isfinite(value):
+            continue
+        if normaliser is not None:
+            scale = figures.get(normaliser)
+            if not scale:
+                continue
+            value = value / scale
+        return abs(float(value))
+    return math.nan
+
+
+def _smallest_contact_feature(scene: Scene) -> float:
+    from clearbench.harness.measure.figures import shape_size
+
+    expanded = scene.expanded
+    shapes = {(b.name, s.name): s for b in expanded.bodies for s in b.shapes}
+    sizes = [min(shape_size(shapes[(c.body_a, c.shape_a)]),
+                 shape_size(shapes[(c.body_b, c.shape_b)])) for c in expanded.contacts]
+    sizes += [j.radial_clearance for j in scene.clearance_joints]
+    finite = [s for s in sizes if math.isfinite(s)]
+    return min(finite) if finite else math.inf
+
+
+def _body_size(scene: Scene, body: str) -> float:
+    from clearbench.harness.measure.figures import _body_size as size
+
+    return size(scene.body(body))
+
+
+def _within(value, bound) -> bool | None:
+    if value is None or not math.isfinite(value):
+        return None
+    return abs(value) <= bound
+
+
+def judge(scene: Scene, kind: str, body: str | None, figures: dict) -> tuple[bool | None, str]:
+    """(passed, criterion) of one expectation result; passed is None when the figures do not
+    allow a verdict (no samples, event not reached)."""
+    get = figures.get
+    if kind == "bounce_apex":
+        return _within(get("apex_max_relative_error"), 0.05), "apex within 5 %"
+    if kind in ("incline_stick", "sticks"):
+        bound = 1e-4 * _body_size(scene, body)
+        return _within(get("displacement"), bound), f"displacement <= {bound:.3g}"
+    if kind == "incline_slide":
+        return _within(get("acceleration_relative_error"), 0.02), "acceleration within 2 %"
+    if kind == "sliding_stop":
+        return _within(analytic_error(kind, figures), 0.02), "stop distance within 2 %"
+    if kind == "rolling_transition":
+        return _within(get("final_speed_relative_error"), 0.02), "final speed within 2 %"
+    if kind == "pendulum":
+        period = _within(get("period_relative_error"), 0.01)
+        energy = _within(get("energy_drift"), 0.01)
+        verdicts = [v for v in (period, energy) if v is not None]
+        return (all(verdicts) if verdicts else None), "period within 1 %, energy drift <= 1 %"
+    if kind == "torque_free":
+        return _within(get("angular_momentum_drift"), 0.01), "momentum drift <= 1 %"
+    if kind == "slider_crank":
+        return _within(get("slider_position_relative_error"), 0.01), \
+            "slider position within 1 % of the crank"
+    if kind == "rocking_ratio":
+        return _within(get("ratio_relative_error"), 0.05), "impact ratio within 5 %"
+    if kind == "approaches_ideal":
+        return _within(get("clearance_excess_relative"), 1.0), "excess <= one clearance"
+    if kind == "energy_non_increasing":
+        return _within(get("energy_growth_relative"), 0.01), "energy growth <= 1 %"
+    if kind == "energy_conserved":
+        return _within(get("energy_drift_relative"), 0.01), "energy drift <= 1 %"
+    if kind == "no_penetration":
+        bound = 0.01 * _smallest_contact_feature(scene)
+        return _within(get("penetration_max"), bound), f"penetration <= {bound:.3g}"
+    return None, "no criterion"

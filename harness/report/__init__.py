@@ -1,0 +1,1 @@
+"""The comparison report: HTML page and Markdown summary from a results store."""

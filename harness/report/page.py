@@ -1,0 +1,458 @@
+"""The comparison report: a self-contained HTML page and a Markdown summary from a results store.
+
+Contents: an overview matrix (scene x engine: verdict and headline metric), the stiff and
+extreme suite in the same form, per scene a table of every run with its metrics, the
+work–precision plot with its Pareto front and drift and creep over time, and per engine the
+features it approximates or does not support (from ``Engine.capabilities``, recorded with each
+run); when ``clearbench c60 validate`` has written its JSON, the C-60 table against the paper
+and its force-displacement figures. Figures are embedded as base64 PNG in the HTML and written
+as PNG files beside the Markdown.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import json
+import logging
+import math
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from pathlib import Path
+
+import numpy as np
+
+from clearbench.harness.measure.headline import (
+    METRIC_LABELS,
+    format_value,
+    headline,
+    scene_metric_names,
+)
+from clearbench.harness.report.figures import time_series_figure, work_precision_figure
+from clearbench.harness.run.store import ResultsStore
+from clearbench.harness.studies.sweep import work_precision_points
+from clearbench.scenarios.scene import Scene
+
+LOG = logging.getLogger(__name__)
+
+FINE_SUFFIX = ":fine-reference"
+STATUS_COLOURS = {"ok": "#d9f2d9", "diverged": "#f8d0d0", "crashed": "#f4b6b6",
+                  "timed_out": "#fbe3b8", "unsupported": "#e4e4e4"}
+
+
+@dataclass
+class SceneSection:
+    """What the report says about one scene."""
+
+    name: str
+    scene: Scene | None
+    runs: object                         # DataFrame of every run of the scene
+    representative: dict                 # engine label -> row (dict) at the scene's step
+    figures: dict = field(default_factory=dict)   # title -> PNG bytes
+    notes: list = field(default_factory=list)
+
+
+@dataclass
+class ReportData:
+    frame: object
+    sections: list
+    engines: list
+    approximations: dict                 # label -> {feature: (support, detail)}
+    store: str
+    generated: str
+    c60_validation: dict | None = None   # clearbench c60 validate's JSON (see load_c60_validation)
+
+
+def _representative(rows, scene: Scene | None) -> dict:
+    """Per engine label, the run at the scene's comfortable step (else the closest step)."""
+    chosen = {}
+    regular = rows[~rows["campaign"].fillna("").str.endswith(FINE_SUFFIX)]
+    if not len(regular):
+        regular = rows
+    for label, group in regular.groupby("label", sort=True):
+        target = scene.time_step if scene is not None else group["time_step"].max()
+        distance = np.abs(np.log(group["time_step"].astype(float) / target))
+        chosen[label] = group.loc[distance.idxmin()].to_dict()
+    return chosen
+
+
+def collect(store: ResultsStore, figures: bool = True) -> ReportData:
+    """Gather the report's content from ``store`` (figures computed when ``figures``)."""
+    frame = store.dataframe()
+    sections = []
+    approximations: dict[str, dict] = {}
+    for _, row in frame.iterrows():
+        support = json.loads(row["capabilities"] or "{}")
+        for feature, (kind, detail) in support.items():
+            if kind != "native":
+                approximations.setdefault(row["label"], {})[feature] = (kind, detail)
+    for name in dict.fromkeys(frame["scene_name"]):
+        rows = frame[frame["scene_name"] == name]
+        latest_hash = rows.iloc[-1]["scene_hash"]
+        scene = store.scene(latest_hash)
+        section = SceneSection(name, scene, rows, _representative(rows, scene))
+        if rows["scene_hash"].nunique() > 1:
+            section.notes.append(f"{rows['scene_hash'].nunique()} scene variants share this "
+                                 "name (different parameters); they are listed together.")
+        if figures:
+            _figures(store, section)
+        sections.append(section)
+    sections.sort(key=lambda s: (s.scene is not None and "stiff" in s.scene.tags, s.name))
+    return ReportData(frame, sections, sorted(frame["label"].unique()) if len(frame) else [],
+                      approximations, str(store.directory),
+                      datetime.now(UTC).isoformat(timespec="seconds"))
+
+
+def _figures(store: ResultsStore, section: SceneSection) -> None:
+    points = work_precision_points(section.runs, section.name)
+    if np.count_nonzero(points["error"] > 0) >= 2:
+        section.figures["Work–precision"] = work_precision_figure(
+            points, f"{section.name}: error against stepping time")
+    if section.scene is None:
+        section.notes.append("scene not in the store: no time-series figure")
+        return
+    trajectories = {}
+    for label, row in section.representative.items():
+        if row["status"] in ("ok", "diverged") and row["trajectory"]:
+            trajectory = store.load_trajectory(row["key"])
+            if trajectory is not None and trajectory.scene_hash == section.scene.content_hash:
+                trajectories[f"{label} dt={row['time_step']:.3g}"] = trajectory
+    if not trajectories:
+        return
+    try:
+        image = time_series_figure(section.scene, trajectories)
+    except Exception as error:  # a figure must never stop the report
+        LOG.warning("no time-series figure for %s: %s", section.name, error)
+        section.notes.append(f"drift figure not drawn: {type(error).__name__}: {error}")
+        return
+    if image is not None:
+        section.figures["Drift and creep over time"] = image
+
+
+# ---------------------------------------------------------------------------- content helpers
+def _cell(row: dict | None, scene: Scene | None) -> tuple[str, str, str]:
+    """(status, headline text, title) of an overview cell."""
+    if row is None:
+        return "", "not run", ""
+    figures = json.loads(row["metrics"] or "{}")
+    name, value = headline(scene, figures) if scene is not None else ("", math.nan)
+    label = METRIC_LABELS.get(name, (name, ""))[0]
+    text = f"{label} {format_value(value)}" if name else ""
+    passed = row.get("expectations_passed")
+    if passed is not None and not (isinstance(passed, float) and math.isnan(passed)):
+        text += " ✓" if int(passed) else " ✗ expectation"
+    return row["status"], text, row.get("message") or ""
+
+
+def _metric_columns(section: SceneSection) -> list[str]:
+    present = set()
+    for text in section.runs["metrics"]:
+        present.update(json.loads(text or "{}"))
+    names = scene_metric_names(section.scene) if section.scene is not None else sorted(present)
+    return [n for n in names if n in present]
+
+
+def _engine_notes(data: ReportData) -> list[tuple[str, str, str, str]]:
+    rows = []
+    for label in data.engines:
+        for feature, (kind, detail) in sorted(data.approximations.get(label, {}).items()):
+            rows.append((label, feature, kind, detail))
+    return rows
+
+
+# ---------------------------------------------------------------------------- HTML
+CSS = """
+body{font-family:system-ui,-apple-system,Segoe UI,Helvetica,Arial,sans-serif;margin:2em auto;
+max-width:1100px;color:#222;line-height:1.4;padding:0 1em}
+h1{font-size:1.6em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:2em}
+table{border-collapse:collapse;margin:.6em 0;font-size:.86em}
+th,td{border:1px solid #ccc;padding:.25em .5em;text-align:left;vertical-align:top}
+th{background:#f3f3f3}td.num{text-align:right;font-variant-numeric:tabular-nums}
+.status{font-weight:600}.small{color:#666;font-size:.85em}img{max-width:100%}
+.figs{display:flex;flex-wrap:wrap;gap:1em}.figs figure{margin:0}
+"""
+
+
+def _esc(value) -> str:
+    return html.escape(str(value))
+
+
+def _status_td(status: str, text: str = "", title: str = "") -> str:
+    colour = STATUS_COLOURS.get(status, "#ffffff")
+    body = f"<span class='status'>{_esc(status)}</span>" if status else ""
+    if text:
+        body += f"<br><span class='small'>{_esc(text)}</span>"
+    return f"<td style='background:{colour}' title='{_esc(title)}'>{body}</td>"
+
+
+def _overview_html(data: ReportData, stiff: bool) -> str:
+    sections = [s for s in data.sections
+                if (s.scene is not None and "stiff" in s.scene.tags) == stiff]
+    if not sections:
+        return ""
+    head = "".join(f"<th>{_esc(label)}</th>" for label in data.engines)
+    body = []
+    for section in sections:
+        cells = "".join(_status_td(*_cell(section.representative.get(label), section.scene))
+                        for label in data.engines)
+        step = f"{section.scene.time_step:g} {section.scene.units.time}" if section.scene else ""
+        body.append(f"<tr><td><a href='#scene-{_esc(section.name)}'>{_esc(section.name)}</a>"
+                    f"<br><span class='small'>dt {step}</span></td>{cells}</tr>")
+    title = "Stiff and extreme suite" if stiff else "Overview"
+    note = ("each engine at the case's own (hard) step" if stiff else
+            "each engine at the scene's comfortable step; the headline metric of the scene")
+    return (f"<h2>{title}</h2><p class='small'>{note}; ✓/✗: expectations of the scene.</p>"
+            f"<table><tr><th>scene</th>{head}</tr>{''.join(body)}</table>")
+
+
+def _runs_table_html(section: SceneSection) -> str:
+    columns = _metric_columns(section)
+    head = "".join(f"<th>{_esc(METRIC_LABELS.get(c, (c,))[0])}</th>" for c in columns)
+    rows = []
+    for _, run in section.runs.sort_values(["label", "time_step"]).iterrows():
+        figures = json.loads(run["metrics"] or "{}")
+        role = " (fine reference)" if str(run["campaign"]).endswith(FINE_SUFFIX) else ""
+        cells = "".join(f"<td class='num'>{_esc(format_value(figures.get(c)))}</td>"
+                        for c in columns)
+        passed = run["expectations_passed"]
+        mark = "—" if passed is None or (isinstance(passed, float) and math.isnan(passed)) \
+            else ("pass" if int(passed) else "FAIL")
+        rows.append(
+            f"<tr><td>{_esc(run['label'] + role)}</td><td class='num'>{run['time_step']:.3g}"
+            f"</td>{_status_td(run['status'], '', run['message'] or '')}<td>{mark}</td>{cells}"
+            f"<td class='num'>{_esc(format_value(run['stepping_seconds_per_step'], 's'))}</td>"
+            f"<td class='num'>"
+            f"{_esc(format_value(run['stepping_seconds_per_simulated_second'], 's'))}</td></tr>")
+    return ("<table><tr><th>engine</th><th>dt</th><th>verdict</th><th>expectations</th>"
+            f"{head}<th>stepping / step</th><th>stepping / sim. unit</th></tr>"
+            f"{''.join(rows)}</table>")
+
+
+def _messages_html(section: SceneSection) -> str:
+    items = []
+    for label, row in section.representative.items():
+        if row["status"] != "ok" and row.get("message"):
+            items.append(f"<li><b>{_esc(label)}</b> {_esc(row['status'])}: "
+                         f"{_esc(row['message'])}</li>")
+        for result in json.loads(row["expectations"] or "[]"):
+            if result.get("passed") is False:
+                items.append(f"<li><b>{_esc(label)}</b> fails {_esc(result.get('name'))}: "
+                             f"{_esc(result.get('message', ''))}</li>")
+        if row.get("metrics_error"):
+            items.append(f"<li><b>{_esc(label)}</b> metrics not computed: "
+                         f"{_esc(row['metrics_error'])}</li>")
+    return f"<ul>{''.join(items)}</ul>" if items else ""
+
+
+def _section_html(section: SceneSection) -> str:
+    scene = section.scene
+    intro = _esc(scene.description) if scene is not None else ""
+    units = f" Units: {_esc(scene.units.describe())}." if scene is not None and hasattr(
+        scene.units, "describe") else ""
+    figures = "".join(
+        f"<figure><img alt='{_esc(title)} of {_esc(section.name)}' "
+        f"src='data:image/png;base64,{base64.b64encode(png).decode()}'>"
+        f"<figcaption class='small'>{_esc(title)}</figcaption></figure>"
+        for title, png in section.figures.items())
+    notes = "".join(f"<p class='small'>{_esc(n)}</p>" for n in section.notes)
+    return (f"<h2 id='scene-{_esc(section.name)}'>{_esc(section.name)}</h2><p>{intro}{units}</p>"
+            f"{_runs_table_html(section)}{_messages_html(section)}"
+            f"<div class='figs'>{figures}</div>{notes}")
+
+
+def _engines_html(data: ReportData) -> str:
+    rows = "".join(f"<tr><td>{_esc(a)}</td><td>{_esc(b)}</td><td>{_esc(c)}</td>"
+                   f"<td>{_esc(d)}</td></tr>" for a, b, c, d in _engine_notes(data))
+    versions = data.frame.groupby("label")["engine_version"].last() if len(data.frame) else {}
+    version_rows = "".join(f"<tr><td>{_esc(k)}</td><td>{_esc(v)}</td></tr>"
+                           for k, v in dict(versions).items())
+    table = (f"<table><tr><th>engine</th><th>feature</th><th>support</th><th>how</th></tr>"
+             f"{rows}</table>") if rows else "<p>Every feature used was native.</p>"
+    return ("<h2>Engines and their approximations</h2>"
+            f"<table><tr><th>engine</th><th>version</th></tr>{version_rows}</table>"
+            "<p class='small'>Features of the scenes run that an engine only approximates or "
+            f"does not support, as the engine states it (Engine.capabilities):</p>{table}")
+
+
+def load_c60_validation(path: str | Path | None) -> dict | None:
+    """The JSON written by ``clearbench c60 validate`` (table, findings, runs, figures), with
+    the figures read in as PNG bytes under ``"figure_png"``; None when ``path`` is None or
+    does not exist (the C-60 section is then left out)."""
+    if path is None or not Path(path).is_file():
+        return None
+    document = json.loads(Path(path).read_text())
+    base = Path(path).parent
+    document["figure_png"] = {}
+    for title, relative in document.get("figures", {}).items():
+        figure = base / relative
+        if figure.is_file():
+            document["figure_png"][title] = figure.read_bytes()
+        else:
+            LOG.warning("C-60 validation figure %s is missing", figure)
+    return document
+
+
+def _c60_number(value, digits: int = 3) -> str:
+    return "-" if value is None else f"{value:.{digits}f}"
+
+
+def _c60_difference(value) -> str:
+    return "-" if value is None else f"{100 * value:+.1f} %"
+
+
+def _c60_html(validation: dict) -> str:
+    rows = "".join(
+        f"<tr><td>{_esc(r['quantity'])}{_esc(' (' + r['note'] + ')') if r['note'] else ''}"
+        f"</td><td>{_esc(r['unit'])}</td><td>{_c60_number(r['ours'])}</td>"
+        f"<td>{_c60_number(r['paper_simulated'])}</td><td>{_c60_number(r['paper_measured'])}"
+        f"</td><td>{_c60_difference(r['difference'])}</td></tr>" for r in validation["rows"])
+    causes = "".join(f"<li>{_esc(r['quantity'])}: {_c60_difference(r['difference'])}. What we "
+                     f"believe causes it: {_esc(r['believed_cause'])}</li>"
+                     for r in validation["rows"] if r.get("believed_cause"))
+    findings = "".join(f"<li>{_esc(f)}</li>" for f in validation.get("findings", []))
+    figures = "".join(
+        f"<figure><img alt='{_esc(title)}' src='data:image/png;base64,"
+        f"{base64.b64encode(png).decode()}'><figcaption>{_esc(title)}</figcaption></figure>"
+        for title, png in validation.get("figure_png", {}).items())
+    return (f"<h2>{_esc(validation['title'])}</h2>"
+            f"<p class='small'>From <code>{_esc(validation['source'])}</code> (reference "
+            f"engine, preset {_esc(validation['preset'])}); paper: {_esc(validation['paper'])}."
+            " Differences are relative to the measured value where there is one, else to the "
+            "paper's simulated value; nothing is tuned to them.</p>"
+            "<table><tr><th>quantity</th><th>unit</th><th>ours</th><th>paper, simulated</th>"
+            f"<th>paper, measured</th><th>difference</th></tr>{rows}</table>"
+            f"<h3>Differences above 10 %</h3><ul class='small'>{causes}</ul>"
+            f"<h3>Findings</h3><ul class='small'>{findings}</ul>{figures}")
+
+
+def _c60_markdown(validation: dict, figure_files: dict) -> list[str]:
+    lines = [f"## {validation['title']}", "",
+             f"From `{validation['source']}` (reference engine, preset {validation['preset']});"
+             f" paper: {validation['paper']}.", "",
+             "| quantity | unit | ours | paper, simulated | paper, measured | difference |",
+             "|---|---|---|---|---|---|"]
+    for r in validation["rows"]:
+        note = f" ({r['note']})" if r["note"] else ""
+        lines.append(f"| {_md_escape(r['quantity'] + note)} | {r['unit']} | "
+                     f"{_c60_number(r['ours'])} | {_c60_number(r['paper_simulated'])} | "
+                     f"{_c60_number(r['paper_measured'])} | "
+                     f"{_c60_difference(r['difference'])} |")
+    lines.append("")
+    lines += [f"- {_md_escape(r['quantity'])}: {_c60_difference(r['difference'])}. What we "
+              f"believe causes it: {_md_escape(r['believed_cause'])}"
+              for r in validation["rows"] if r.get("believed_cause")]
+    lines += [f"- {_md_escape(f)}" for f in validation.get("findings", [])]
+    for title, path in figure_files.items():
+        lines += ["", f"![{title}]({path})"]
+    return lines + [""]
+
+
+def render_html(data: ReportData) -> str:
+    frame = data.frame
+    machines = ", ".join(sorted({f"{h} ({c}, {n} cores)" for h, c, n in
+                                 zip(frame["hostname"], frame["cpu"], frame["cores"],
+                                     strict=True)})) if len(frame) else "none"
+    revisions = ", ".join(sorted(set(frame["git_revision"].str[:12]))) if len(frame) else ""
+    counts = frame["status"].value_counts().to_dict() if len(frame) else {}
+    summary = ", ".join(f"{v} {k}" for k, v in sorted(counts.items()))
+    body = [
+        "<h1>clearbench comparison report</h1>",
+        f"<p class='small'>Generated {data.generated} from store {_esc(data.store)}: "
+        f"{len(frame)} runs ({_esc(summary)}). Machines: {_esc(machines)}. Revisions: "
+        f"{_esc(revisions)}. Metrics are computed by the harness from each trajectory with "
+        "shared geometry, never taken from an engine; times are wall-clock seconds of "
+        "stepping alone.</p>",
+        _overview_html(data, stiff=False),
+        _overview_html(data, stiff=True),
+        *(_section_html(s) for s in data.sections),
+        _c60_html(data.c60_validation) if data.c60_validation else "",
+        _engines_html(data),
+    ]
+    return ("<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
+            "<meta name='viewport' content='width=device-width, initial-scale=1'>"
+            f"<title>clearbench report</title><style>{CSS}</style></head><body>"
+            f"{''.join(body)}</body></html>\n")
+
+
+# ---------------------------------------------------------------------------- Markdown
+def _md_escape(text) -> str:
+    return str(text).replace("|", "\\|").replace("\n", " ")
+
+
+def render_markdown(data: ReportData, figure_files: dict, c60_figure_files: dict | None = None
+                    ) -> str:
+    lines = ["# clearbench comparison report", "",
+             f"Generated {data.generated} from `{data.store}`: {len(data.frame)} runs. "
+             "Full report with figures: `report.html`.", ""]
+    for stiff in (False, True):
+        sections = [s for s in data.sections
+                    if (s.scene is not None and "stiff" in s.scene.tags) == stiff]
+        if not sections:
+            continue
+        lines += [f"## {'Stiff and extreme suite' if stiff else 'Overview'}", "",
+                  "| scene | " + " | ".join(data.engines) + " |",
+                  "|---|" + "---|" * len(data.engines)]
+        for section in sections:
+            cells = []
+            for label in data.engines:
+                status, text, _ = _cell(section.representative.get(label), section.scene)
+                cells.append(_md_escape(f"**{status}** {text}".strip() if status else text))
+            lines.append(f"| {section.name} | " + " | ".join(cells) + " |")
+        lines.append("")
+    for section in data.sections:
+        columns = _metric_columns(section)
+        lines += [f"### {section.name}", "",
+                  "| engine | dt | verdict | " + " | ".join(
+                      METRIC_LABELS.get(c, (c,))[0] for c in columns) + " | stepping/step |",
+                  "|---|---|---|" + "---|" * len(columns) + "---|"]
+        for _, run in section.runs.sort_values(["label", "time_step"]).iterrows():
+            figures = json.loads(run["metrics"] or "{}")
+            role = " (fine ref)" if str(run["campaign"]).endswith(FINE_SUFFIX) else ""
+            lines.append(f"| {run['label']}{role} | {run['time_step']:.3g} | {run['status']} | "
+                         + " | ".join(format_value(figures.get(c)) for c in columns)
+                         + f" | {format_value(run['stepping_seconds_per_step'], 's')} |")
+        for title, path in figure_files.get(section.name, {}).items():
+            lines += ["", f"![{title}]({path})"]
+        lines.append("")
+    if data.c60_validation:
+        lines += _c60_markdown(data.c60_validation, c60_figure_files or {})
+    notes = _engine_notes(data)
+    if notes:
+        lines += ["## Engine approximations", "", "| engine | feature | support | how |",
+                  "|---|---|---|---|"]
+        lines += [f"| {a} | {b} | {c} | {_md_escape(d)} |" for a, b, c, d in notes]
+        lines.append("")
+    return "\n".join(lines)
+
+
+#: Where ``clearbench c60 validate`` writes its JSON (committed with the repository).
+C60_VALIDATION = Path("reports/c60_validation.json")
+
+
+def write_report(store: ResultsStore, out_dir: str | Path,
+                 c60_validation: str | Path | None = C60_VALIDATION) -> dict[str, Path]:
+    """Write ``report.html``, ``summary.md`` and ``figures/*.png`` into ``out_dir``.
+
+    ``c60_validation``: the JSON of ``clearbench c60 validate``; when it exists the report has
+    a section with the C-60 table against the paper and its force-displacement figures."""
+    out = Path(out_dir)
+    (out / "figures").mkdir(parents=True, exist_ok=True)
+    data = collect(store)
+    data.c60_validation = load_c60_validation(c60_validation)
+    c60_figure_files: dict[str, str] = {}
+    if data.c60_validation:
+        for index, (title, png) in enumerate(data.c60_validation["figure_png"].items()):
+            name = f"figures/c60-validation-{index}.png"
+            (out / name).write_bytes(png)
+            c60_figure_files[title] = name
+    figure_files: dict[str, dict[str, str]] = {}
+    for section in data.sections:
+        for index, (title, png) in enumerate(section.figures.items()):
+            name = f"figures/{section.name}-{index}.png"
+            (out / name).write_bytes(png)
+            figure_files.setdefault(section.name, {})[title] = name
+    html_path = out / "report.html"
+    md_path = out / "summary.md"
+    html_path.write_text(render_html(data), encoding="utf-8")
+    md_path.write_text(render_markdown(data, figure_files, c60_figure_files), encoding="utf-8")
+    return {"html": html_path, "markdown": md_path}

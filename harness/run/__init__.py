@@ -1,0 +1,1 @@
+"""Runs: their specification, engine choice, isolated worker processes, and the results store."""

@@ -1,0 +1,120 @@
+"""Engine choices as users write them (``mujoco[elliptic]``), resolved and checked before any
+engine runs.
+
+An engine is found through :data:`clearbench.adapters.registry.ENGINE_MODULES`, or through
+extra adapter modules given by the caller (``{"mine": "my_package.my_adapter"}``), which follow
+the same contract (:mod:`clearbench.adapters.base`): ``availability() -> (bool, str)`` and
+``create(preset) -> Engine``. Where the adapter module declares ``PRESETS`` (a mapping) and
+``OPTION_NAMES`` (a sequence), presets and option names are checked against them without
+creating an engine.
+"""
+
+from __future__ import annotations
+
+import importlib
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+from clearbench.adapters.registry import ENGINE_MODULES, engine_availability
+
+_LABEL = re.compile(r"^\s*([A-Za-z0-9_.-]+)\s*(?:\[\s*([A-Za-z0-9_.+-]*)\s*\])?\s*$")
+
+
+class RunInputError(ValueError):
+    """Bad input to a run (unknown scene, engine or preset, bad setting): names the field and
+    the value at fault. Raised before any engine runs."""
+
+    def __init__(self, field: str, value, reason: str):
+        self.field = field
+        self.value = value
+        self.reason = reason
+        super().__init__(f"{field} = {value!r}: {reason}")
+
+
+@dataclass(frozen=True)
+class EngineChoice:
+    """A resolved engine: its name, preset, adapter module path and what it said about itself."""
+
+    name: str
+    preset: str
+    module: str
+    detail: str
+
+    @property
+    def label(self) -> str:
+        """``name[preset]`` as used in results."""
+        return f"{self.name}[{self.preset}]"
+
+
+def parse_engine_label(text: str, field: str = "engine") -> tuple[str, str]:
+    """``'mujoco[elliptic]'`` -> ``('mujoco', 'elliptic')``; ``'reference'`` -> default preset."""
+    match = _LABEL.match(str(text))
+    if not match:
+        raise RunInputError(field, text,
+                            "expected ENGINE or ENGINE[PRESET], e.g. reference[newton]")
+    name, preset = match.group(1), match.group(2)
+    return name, preset or "default"
+
+
+def engine_module_path(name: str, extra_modules: Mapping[str, str] | None = None) -> str:
+    """Fully qualified adapter module of engine ``name``."""
+    if extra_modules and name in extra_modules:
+        return extra_modules[name]
+    if name in ENGINE_MODULES:
+        return f"clearbench.adapters.{ENGINE_MODULES[name]}"
+    known = sorted(set(ENGINE_MODULES) | set(extra_modules or {}))
+    raise RunInputError("engine", name, f"unknown engine; engines: {', '.join(known)}")
+
+
+def resolve_engine(text: str, extra_modules: Mapping[str, str] | None = None,
+                   options: Mapping | None = None, field: str = "engine") -> EngineChoice:
+    """Parse, find, and check an engine choice (availability, preset, option names).
+
+    Raises
+    ------
+    RunInputError
+        Unknown engine, engine not available here, unknown preset or option.
+    """
+    name, preset = parse_engine_label(text, field)
+    module_path = engine_module_path(name, extra_modules)
+    if extra_modules and name in extra_modules:
+        try:
+            module = importlib.import_module(module_path)
+            available, detail = module.availability()
+        except Exception as error:  # an adapter that cannot even report is unavailable
+            raise RunInputError(field, text, f"adapter {module_path} failed to load: {error}") \
+                from None
+    else:
+        availability = engine_availability(name)
+        available, detail = availability.available, availability.detail
+        module = importlib.import_module(module_path) if available else None
+    if not available:
+        raise RunInputError(field, text, f"engine not available here: {detail}")
+    presets = getattr(module, "PRESETS", None)
+    if isinstance(presets, Mapping):
+        if preset not in presets:
+            raise RunInputError(f"{field} preset", preset,
+                                f"unknown {name} preset; presets: {', '.join(presets)}")
+    else:
+        try:
+            module.create(preset)
+        except Exception as error:
+            raise RunInputError(f"{field} preset", preset, f"{name} refused it: {error}") \
+                from None
+    choice = EngineChoice(name, preset, module_path, str(detail))
+    check_options(choice, options)
+    return choice
+
+
+def check_options(choice: EngineChoice, options: Mapping | None) -> None:
+    """RunInputError when an option is unknown to an adapter that declares OPTION_NAMES."""
+    if not options:
+        return
+    option_names = getattr(importlib.import_module(choice.module), "OPTION_NAMES", None)
+    if option_names is None:
+        return
+    unknown = sorted(set(options) - set(option_names))
+    if unknown:
+        raise RunInputError("options", ", ".join(unknown),
+                            f"unknown {choice.name} options; options: {', '.join(option_names)}")

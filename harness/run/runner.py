@@ -1,0 +1,318 @@
+"""Run many :class:`~.run_spec.RunSpec` in isolated worker processes, in parallel, into a store.
+
+Each run executes in a worker process started with the ``spawn`` context (by default a fresh
+one per run: ``runs_per_worker=1``). The parent waits on the workers' pipes and process
+sentinels, so that
+
+- a worker that dies (segfault, abort, out of memory) gives a ``crashed`` run with the signal;
+- a worker past its wall-clock limit is killed (its whole process group) and gives ``timed_out``;
+- an exception in an engine gives ``crashed`` with the exception; non-finite values ``diverged``;
+
+and the parent carries on with the rest of the sweep. A run is written to the results store only
+once complete (outcome and metrics), in one transaction, under its deterministic key; runs whose
+key is already in the store are skipped, so a sweep interrupted even by ``kill -9`` resumes
+without losing or duplicating runs.
+"""
+
+from __future__ import annotations
+
+import logging
+import multiprocessing
+import multiprocessing.connection
+import os
+import signal
+import time
+from collections import deque
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from clearbench.adapters.trajectory import RunStatus
+from clearbench.harness.run.spec import RunSpec
+from clearbench.harness.run.store import ResultsStore, RunRecord, machine_info, revision_info
+from clearbench.harness.run.worker import worker_main
+
+LOG = logging.getLogger(__name__)
+
+#: Wall-clock limit of the measuring phase of one run [s].
+MEASURE_TIMEOUT = 600.0
+#: Seconds to wait for a worker to exit after it was asked to.
+EXIT_GRACE = 5.0
+
+
+def default_jobs() -> int:
+    """Cores this process may use."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # pragma: no cover - not Linux
+        return max(1, os.cpu_count() or 1)
+
+
+@dataclass
+class RunJob:
+    """A spec to run, and the trajectory its error is measured against (if any)."""
+
+    spec: RunSpec
+    reference_key: str | None = None
+
+
+@dataclass
+class _Slot:
+    process: multiprocessing.process.BaseProcess
+    conn: multiprocessing.connection.Connection
+    runs_done: int = 0
+    job: RunJob | None = None
+    phase: str = ""
+    deadline: float = 0.0
+    started: float = 0.0
+    ran: dict | None = None
+    trajectory_tmp: Path | None = None
+
+
+@dataclass
+class SweepOutcome:
+    """What :func:`run_all` did: keys run now, keys found already stored, records written."""
+
+    ran: list[str] = field(default_factory=list)
+    skipped: list[str] = field(default_factory=list)
+    records: list[RunRecord] = field(default_factory=list)
+
+
+def _signal_name(exitcode: int | None) -> str:
+    if exitcode is None:
+        return "unknown exit"
+    if exitcode < 0:
+        try:
+            return f"killed by signal {signal.Signals(-exitcode).name}"
+        except ValueError:
+            return f"killed by signal {-exitcode}"
+    return f"exited with status {exitcode}"
+
+
+class Runner:
+    """Runs jobs in ``jobs`` parallel worker processes into ``store``.
+
+    Parameters
+    ----------
+    store : ResultsStore
+    jobs : int
+        Parallel workers (default: the cores this process may use).
+    runs_per_worker : int
+        Runs a worker serves before it is replaced (1: a fresh process per run). A worker that
+        crashed or timed out is always replaced.
+    progress : bool
+        Show a tqdm progress bar on stderr.
+    measure_timeout : float
+        Wall-clock limit of the measuring phase [s].
+    """
+
+    def __init__(self, store: ResultsStore, jobs: int | None = None, runs_per_worker: int = 1,
+                 progress: bool = False, measure_timeout: float = MEASURE_TIMEOUT):
+        self.store = store
+        self.jobs = max(1, int(jobs or default_jobs()))
+        self.runs_per_worker = max(1, int(runs_per_worker))
+        self.progress = progress
+        self.measure_timeout = measure_timeout
+        self._context = multiprocessing.get_context("spawn")
+        self._slots: list[_Slot] = []
+        self._revision = revision_info()
+        self._machine = machine_info()
+
+    # ------------------------------------------------------------------ workers
+    def _start_worker(self) -> _Slot:
+        parent_conn, child_conn = self._context.Pipe(duplex=True)
+        process = self._context.Process(target=worker_main, args=(child_conn, os.getpid()),
+                                        daemon=True, name="clearbench-worker")
+        process.start()
+        child_conn.close()
+        return _Slot(process, parent_conn)
+
+    def _kill(self, slot: _Slot) -> None:
+        pid = slot.process.pid
+        if pid is not None and slot.process.is_alive():
+            try:
+                os.killpg(pid, signal.SIGKILL)  # the worker leads its own process group
+            except (ProcessLookupError, PermissionError):
+                slot.process.kill()
+        slot.process.join(EXIT_GRACE)
+        slot.conn.close()
+
+    def _retire(self, slot: _Slot) -> None:
+        try:
+            slot.conn.send(None)
+        except (BrokenPipeError, OSError):
+            pass
+        slot.process.join(EXIT_GRACE)
+        if slot.process.is_alive():
+            self._kill(slot)
+        else:
+            slot.conn.close()
+
+    def close(self) -> None:
+        """Stop every worker."""
+        for slot in self._slots:
+            if slot.job is not None:
+                self._kill(slot)
+            else:
+                self._retire(slot)
+        self._slots = []
+
+    # ------------------------------------------------------------------ running
+    def run_all(self, jobs: Iterable[RunJob | RunSpec], rerun: bool = False) -> SweepOutcome:
+        """Run every job whose key is not yet in the store (all of them with ``rerun``).
+
+        Jobs with the same key are run once. Returns what was run and what was skipped.
+        """
+        outcome = SweepOutcome()
+        queue: deque[RunJob] = deque()
+        seen: set[str] = set()
+        stored = self.store.keys()
+        for job in jobs:
+            job = job if isinstance(job, RunJob) else RunJob(job)
+            key = job.spec.key
+            if key in seen:
+                continue
+            seen.add(key)
+            if key in stored and not rerun:
+                outcome.skipped.append(key)
+            else:
+                queue.append(job)
+        if not queue:
+            return outcome
+        bar = None
+        if self.progress:
+            from tqdm import tqdm
+
+            bar = tqdm(total=len(queue), unit="run", desc="runs", leave=False)
+        try:
+            self._loop(queue, outcome, bar, rerun)
+        finally:
+            if bar is not None:
+                bar.close()
+            self.close()
+        return outcome
+
+    def _dispatch(self, slot: _Slot, job: RunJob) -> None:
+        spec = job.spec
+        request = spec.to_message()
+        tmp = self.store.trajectory_dir / f".{spec.key}.{os.getpid()}.tmp.npz"
+        request["trajectory_path"] = str(tmp)
+        reference = None
+        if job.reference_key:
+            path = self.store.trajectory_path(job.reference_key)
+            reference = str(path) if path.exists() else None
+        request["reference_path"] = reference
+        request["reference_label"] = f"reference run {job.reference_key}" if reference else ""
+        slot.job, slot.phase, slot.ran, slot.trajectory_tmp = job, "run", None, tmp
+        slot.started = time.monotonic()
+        slot.deadline = slot.started + spec.timeout
+        slot.conn.send(request)
+
+    def _loop(self, queue: deque, outcome: SweepOutcome, bar, rerun: bool) -> None:
+        while queue or any(s.job is not None for s in self._slots):
+            # fill idle slots
+            while queue and (len(self._slots) < self.jobs
+                             or any(s.job is None for s in self._slots)):
+                idle = next((s for s in self._slots if s.job is None), None)
+                if idle is None:
+                    idle = self._start_worker()
+                    self._slots.append(idle)
+                self._dispatch(idle, queue.popleft())
+            busy = [s for s in self._slots if s.job is not None]
+            now = time.monotonic()
+            wait_for = max(0.0, min(s.deadline for s in busy) - now)
+            handles = [s.conn for s in busy] + [s.process.sentinel for s in busy]
+            multiprocessing.connection.wait(handles, timeout=min(wait_for, 1.0))
+            for slot in busy:
+                finished = self._service(slot)
+                if finished is not None:
+                    record = self._finish(slot, finished, outcome, rerun)
+                    if bar is not None:
+                        bar.update(1)
+                        bar.set_postfix_str(f"{finished.spec.label}: {record.status}",
+                                            refresh=False)
+
+    def _service(self, slot: _Slot):
+        """Advance ``slot``; return a _Finished when its run is complete."""
+        job = slot.job
+        assert job is not None
+        try:
+            while slot.conn.poll():
+                message = slot.conn.recv()
+                if message["phase"] == "ran":
+                    slot.ran = message
+                    slot.phase = "measure"
+                    slot.deadline = time.monotonic() + self.measure_timeout
+                elif message["phase"] == "measured":
+                    slot.runs_done += 1
+                    return _Finished(job.spec, slot.ran, message, slot.trajectory_tmp,
+                                     worker_ok=True)
+        except (EOFError, OSError):
+            pass  # the worker died; handled below
+        if not slot.process.is_alive() or slot.conn.closed:
+            slot.process.join(EXIT_GRACE)
+            why = _signal_name(slot.process.exitcode)
+            return self._abandon(slot, RunStatus.CRASHED, f"worker {why}")
+        if time.monotonic() > slot.deadline:
+            limit = job.spec.timeout if slot.phase == "run" else self.measure_timeout
+            self._kill(slot)
+            return self._abandon(slot, RunStatus.TIMED_OUT,
+                                 f"wall-clock limit of {limit:g} s reached", killed=True)
+        return None
+
+    def _abandon(self, slot: _Slot, status: RunStatus, message: str, killed: bool = False):
+        """The worker died or was killed: the run is over, the worker is replaced."""
+        if not killed:
+            self._kill(slot)
+        elapsed = time.monotonic() - slot.started
+        if slot.phase == "run":
+            ran = {"status": status.value, "message": message, "worker_seconds": elapsed,
+                   "capabilities": {}, "engine_version": "", "trajectory_saved": False}
+            measured = {"figures": {}, "expectations": [], "verdict": None,
+                        "verdict_reason": "", "error_source": "", "metrics_error": ""}
+        else:  # the run finished; its measuring died
+            ran = slot.ran
+            measured = {"figures": {}, "expectations": [], "verdict": None,
+                        "verdict_reason": "", "error_source": "",
+                        "metrics_error": f"measuring {status.value}: {message}"}
+        finished = _Finished(slot.job.spec, ran, measured, slot.trajectory_tmp, worker_ok=False)
+        self._slots.remove(slot)
+        return finished
+
+    def _finish(self, slot: _Slot, finished: _Finished, outcome: SweepOutcome,
+                rerun: bool) -> RunRecord:
+        spec = finished.spec
+        if finished.worker_ok:
+            slot.job = None
+            if slot.runs_done >= self.runs_per_worker:
+                self._retire(slot)
+                self._slots.remove(slot)
+        record = RunRecord.from_worker(spec, finished.ran, finished.measured,
+                                       self._revision, self._machine)
+        tmp = finished.trajectory_tmp
+        saved = bool(finished.ran.get("trajectory_saved")) and tmp is not None and tmp.exists()
+        self.store.record(record, trajectory_file=tmp if saved else None, replace=rerun,
+                          scene=spec.scene)
+        if tmp is not None and tmp.exists():
+            tmp.unlink()
+        outcome.ran.append(spec.key)
+        outcome.records.append(record)
+        LOG.info("%s: %s %s", spec.label, record.status, record.message)
+        return record
+
+
+@dataclass
+class _Finished:
+    spec: RunSpec
+    ran: dict
+    measured: dict
+    trajectory_tmp: Path | None
+    worker_ok: bool
+
+
+def run_specs(specs: Sequence[RunSpec | RunJob], store: ResultsStore, jobs: int | None = None,
+              progress: bool = False, rerun: bool = False,
+              runs_per_worker: int = 1) -> SweepOutcome:
+    """Convenience: run ``specs`` with a fresh :class:`Runner`."""
+    runner = Runner(store, jobs=jobs, progress=progress, runs_per_worker=runs_per_worker)
+    return runner.run_all(specs, rerun=rerun)

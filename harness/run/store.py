@@ -1,0 +1,335 @@
+"""The results store: one SQLite database of runs, plus one .npz trajectory per run beside it.
+
+Layout of a store directory::
+
+    runs.sqlite            table ``runs`` (one row per run, keyed), table ``scenes`` (scene JSON
+                           by content hash), table ``meta`` (schema version)
+    trajectories/KEY.npz   the trajectory of run KEY (clearbench.adapters.trajectory format)
+
+A run is recorded only when complete, in one transaction (the trajectory file is moved into
+place inside it); the key is the primary key, so a run can never be recorded twice, and a sweep
+killed at any instant leaves either the whole run or nothing. ``pandas`` reads it with
+:meth:`ResultsStore.dataframe` (metrics expanded into ``m_<name>`` columns) or directly with
+``pandas.read_sql("select * from runs", sqlite3.connect(path))``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import os
+import platform
+import socket
+import sqlite3
+import subprocess
+import time
+from collections.abc import Iterator
+from dataclasses import asdict, dataclass, fields
+from datetime import UTC, datetime
+from functools import lru_cache
+from pathlib import Path
+
+import clearbench
+from clearbench.adapters.trajectory import RunStatus, Trajectory
+from clearbench.harness.run.spec import RunSpec
+from clearbench.scenarios.scene import Scene
+from clearbench.scenarios.serialization import scene_from_dict, scene_to_dict
+
+SCHEMA_VERSION = 1
+DATABASE = "runs.sqlite"
+TRAJECTORIES = "trajectories"
+
+
+@dataclass(frozen=True)
+class RunRecord:
+    """One row of the ``runs`` table (units: seconds for wall times, the scene's own units for
+    ``time_step``, ``horizon`` and the metrics).
+
+    ``status`` is the verdict: the run's outcome (ok / diverged / crashed / timed_out /
+    unsupported) after the harness's own guards (non-finite values, energy growth, escape);
+    ``engine_status`` is what the engine or worker reported before those guards.
+    """
+
+    key: str
+    recorded_utc: str
+    campaign: str
+    scene_name: str
+    scene_hash: str
+    scene_source: str            # JSON: registry name and parameters, or file
+    engine: str
+    preset: str
+    engine_version: str
+    time_step: float
+    horizon: float
+    record_every: int
+    options: str                 # JSON
+    timeout: float
+    status: str
+    message: str
+    engine_status: str
+    engine_message: str
+    worker_seconds: float        # whole run phase in the worker (import, build, stepping) [s]
+    build_seconds: float         # building the engine model [s]
+    stepping_seconds: float      # stepping alone [s]
+    steps: int
+    samples: int
+    stepping_seconds_per_simulated_second: float
+    stepping_seconds_per_step: float
+    error: float                 # headline error (relative, see run_metrics), NaN when none
+    error_source: str
+    expectations_passed: int | None   # 1 all passed, 0 one failed, None none judged
+    metrics: str                 # JSON: flat name -> float
+    expectations: str            # JSON: list of per-expectation results
+    capabilities: str            # JSON: feature -> [support, detail]
+    verdict_reason: str
+    metrics_error: str
+    git_revision: str
+    git_dirty: int
+    hostname: str
+    cpu: str
+    cores: int
+    python: str
+    clearbench_version: str
+    trajectory: str              # path relative to the store, "" when none
+
+    @classmethod
+    def from_worker(cls, spec: RunSpec, ran: dict, measured: dict, revision: dict,
+                    machine: dict) -> RunRecord:
+        """Assemble a row from the spec and the worker's two messages."""
+        guarded = ran.get("status", RunStatus.CRASHED.value)
+        engine_status = ran.get("engine_status", guarded)
+        status = measured.get("verdict") or guarded
+        message = ran.get("message", "")
+        if measured.get("verdict") and measured["verdict"] != guarded:
+            message = measured.get("verdict_reason", "") or message
+        stepping = float(ran.get("stepping_seconds", math.nan))
+        steps = int(ran.get("steps", 0) or 0)
+        simulated = steps * spec.time_step
+        figures = measured.get("figures", {}) or {}
+        results = measured.get("expectations", []) or []
+        judged = [r.get("passed") for r in results if r.get("passed") is not None]
+        return cls(
+            key=spec.key,
+            recorded_utc=datetime.now(UTC).isoformat(timespec="seconds"),
+            campaign=spec.campaign,
+            scene_name=spec.scene.name,
+            scene_hash=spec.scene.content_hash,
+            scene_source=json.dumps(spec.source.to_dict(), sort_keys=True),
+            engine=spec.engine.name,
+            preset=spec.engine.preset,
+            engine_version=str(ran.get("engine_version", "")),
+            time_step=float(spec.time_step),
+            horizon=float(spec.horizon),
+            record_every=int(spec.record_every),
+            options=json.dumps(spec.options_dict, sort_keys=True),
+            timeout=float(spec.timeout),
+            status=status,
+            message=message,
+            engine_status=engine_status,
+            engine_message=ran.get("engine_message", ran.get("message", "")),
+            worker_seconds=float(ran.get("worker_seconds", math.nan)),
+            build_seconds=float(ran.get("build_seconds", math.nan)),
+            stepping_seconds=stepping,
+            steps=steps,
+            samples=int(ran.get("samples", 0) or 0),
+            stepping_seconds_per_simulated_second=(
+                stepping / simulated if simulated > 0 else math.nan),
+            stepping_seconds_per_step=stepping / steps if steps > 0 else math.nan,
+            error=float(figures.get("error", math.nan)),
+            error_source=measured.get("error_source", ""),
+            expectations_passed=None if not judged else int(all(judged)),
+            metrics=json.dumps(figures, sort_keys=True),
+            expectations=json.dumps(results, sort_keys=True),
+            capabilities=json.dumps(ran.get("capabilities", {}), sort_keys=True),
+            verdict_reason=measured.get("verdict_reason", ""),
+            metrics_error=measured.get("metrics_error", ""),
+            git_revision=revision["revision"],
+            git_dirty=int(revision["dirty"]),
+            hostname=machine["hostname"],
+            cpu=machine["cpu"],
+            cores=int(machine["cores"]),
+            python=machine["python"],
+            clearbench_version=clearbench.__version__,
+            trajectory="",
+        )
+
+
+_SQL_TYPES = {"str": "TEXT", "float": "REAL", "int": "INTEGER", "int | None": "INTEGER"}
+COLUMNS: tuple[str, ...] = tuple(f.name for f in fields(RunRecord))
+
+
+def _create_table_sql() -> str:
+    columns = []
+    for f in fields(RunRecord):
+        sql_type = _SQL_TYPES[str(f.type)]
+        suffix = " PRIMARY KEY" if f.name == "key" else ""
+        columns.append(f"{f.name} {sql_type}{suffix}")
+    return f"CREATE TABLE IF NOT EXISTS runs ({', '.join(columns)})"
+
+
+@lru_cache(maxsize=1)
+def revision_info() -> dict:
+    """Git revision of the clearbench source tree and whether it has uncommitted changes."""
+    root = Path(__file__).resolve().parents[2]
+    try:
+        revision = subprocess.run(["git", "rev-parse", "HEAD"], cwd=root, capture_output=True,
+                                  text=True, timeout=10, check=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
+                               cwd=root, capture_output=True, text=True, timeout=10,
+                               check=True).stdout.strip() != ""
+    except (OSError, subprocess.SubprocessError):
+        return {"revision": f"unknown (clearbench {clearbench.__version__})", "dirty": False}
+    return {"revision": revision, "dirty": dirty}
+
+
+@lru_cache(maxsize=1)
+def machine_info() -> dict:
+    """Host name, CPU model, usable cores and Python version of this machine."""
+    cpu = platform.processor() or platform.machine()
+    with contextlib.suppress(OSError):
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover
+        cores = os.cpu_count() or 1
+    return {"hostname": socket.gethostname(), "cpu": cpu, "cores": cores,
+            "python": platform.python_version()}
+
+
+class ResultsStore:
+    """A results store in ``directory`` (created when missing)."""
+
+    def __init__(self, directory: str | os.PathLike):
+        self.directory = Path(directory)
+        self.trajectory_dir.mkdir(parents=True, exist_ok=True)
+        with self._connect() as connection:
+            connection.execute(_create_table_sql())
+            connection.execute("CREATE TABLE IF NOT EXISTS scenes (scene_hash TEXT PRIMARY KEY, "
+                               "scene_name TEXT, scene_json TEXT)")
+            connection.execute("CREATE TABLE IF NOT EXISTS meta (name TEXT PRIMARY KEY, "
+                               "value TEXT)")
+            connection.execute("INSERT OR IGNORE INTO meta VALUES ('schema_version', ?)",
+                               (str(SCHEMA_VERSION),))
+            version = connection.execute(
+                "SELECT value FROM meta WHERE name = 'schema_version'").fetchone()[0]
+        if int(version) != SCHEMA_VERSION:
+            raise ValueError(f"{self.path}: store schema version {version}, this clearbench "
+                             f"reads version {SCHEMA_VERSION}")
+
+    @property
+    def path(self) -> Path:
+        """The SQLite database."""
+        return self.directory / DATABASE
+
+    @property
+    def trajectory_dir(self) -> Path:
+        return self.directory / TRAJECTORIES
+
+    def trajectory_path(self, key: str) -> Path:
+        return self.trajectory_dir / f"{key}.npz"
+
+    @contextlib.contextmanager
+    def _connect(self) -> Iterator[sqlite3.Connection]:
+        connection = sqlite3.connect(self.path, timeout=60.0, isolation_level=None)
+        try:
+            connection.execute("PRAGMA journal_mode=WAL")
+            connection.execute("PRAGMA synchronous=FULL")
+            yield connection
+        finally:
+            connection.close()
+
+    # ------------------------------------------------------------------ writing
+    def record(self, record: RunRecord, trajectory_file: Path | None = None,
+               replace: bool = False, scene: Scene | None = None) -> bool:
+        """Record a complete run atomically; its trajectory file is moved into the store.
+
+        Returns False (and leaves the store as it was) when the key is already recorded and
+        ``replace`` is False.
+        """
+        with self._connect() as connection:
+            connection.execute("BEGIN IMMEDIATE")
+            try:
+                exists = connection.execute("SELECT 1 FROM runs WHERE key = ?",
+                                            (record.key,)).fetchone() is not None
+                if exists and not replace:
+                    connection.execute("ROLLBACK")
+                    return False
+                row = asdict(record)
+                if trajectory_file is not None:
+                    final = self.trajectory_path(record.key)
+                    os.replace(trajectory_file, final)
+                    row["trajectory"] = str(final.relative_to(self.directory))
+                elif exists:
+                    self.trajectory_path(record.key).unlink(missing_ok=True)
+                placeholders = ", ".join("?" for _ in COLUMNS)
+                connection.execute(
+                    f"INSERT OR REPLACE INTO runs ({', '.join(COLUMNS)}) VALUES ({placeholders})",
+                    [row[c] for c in COLUMNS])
+                if scene is not None:
+                    connection.execute(
+                        "INSERT OR IGNORE INTO scenes VALUES (?, ?, ?)",
+                        (scene.content_hash, scene.name,
+                         json.dumps(scene_to_dict(scene), sort_keys=True)))
+                connection.execute("COMMIT")
+            except BaseException:
+                connection.execute("ROLLBACK")
+                raise
+        return True
+
+    # ------------------------------------------------------------------ reading
+    def keys(self) -> set[str]:
+        with self._connect() as connection:
+            return {row[0] for row in connection.execute("SELECT key FROM runs")}
+
+    def __len__(self) -> int:
+        with self._connect() as connection:
+            return int(connection.execute("SELECT COUNT(*) FROM runs").fetchone()[0])
+
+    def get(self, key: str) -> dict | None:
+        """The row of run ``key`` as a dict (JSON columns left as text), or None."""
+        with self._connect() as connection:
+            connection.row_factory = sqlite3.Row
+            row = connection.execute("SELECT * FROM runs WHERE key = ?", (key,)).fetchone()
+        return dict(row) if row is not None else None
+
+    def scene(self, scene_hash: str) -> Scene | None:
+        """The scene a run was given, by content hash (None when not stored)."""
+        with self._connect() as connection:
+            row = connection.execute("SELECT scene_json FROM scenes WHERE scene_hash = ?",
+                                     (scene_hash,)).fetchone()
+        return scene_from_dict(json.loads(row[0])) if row else None
+
+    def load_trajectory(self, key: str) -> Trajectory | None:
+        path = self.trajectory_path(key)
+        return Trajectory.load(path) if path.exists() else None
+
+    def dataframe(self, expand_metrics: bool = True):
+        """Every run as a pandas DataFrame; ``m_<name>`` columns hold the metrics."""
+        import pandas as pd
+
+        with self._connect() as connection:
+            frame = pd.read_sql_query("SELECT * FROM runs ORDER BY recorded_utc, key",
+                                      connection)
+        frame["label"] = frame["engine"] + "[" + frame["preset"] + "]"
+        if expand_metrics and len(frame):
+            metrics = pd.DataFrame([json.loads(text or "{}") for text in frame["metrics"]],
+                                   index=frame.index)
+            metrics.columns = [f"m_{c}" for c in metrics.columns]
+            frame = pd.concat([frame, metrics], axis=1)
+        return frame
+
+    def clean_partial_files(self, older_than: float = 3600.0) -> int:
+        """Remove temporary trajectory files of runs interrupted more than ``older_than``
+        seconds ago; returns how many were removed."""
+        removed = 0
+        cutoff = time.time() - older_than
+        for path in self.trajectory_dir.glob(".*.npz"):
+            with contextlib.suppress(OSError):
+                if path.stat().st_mtime < cutoff:
+                    path.unlink()
+                    removed += 1
+        return removed

@@ -1,0 +1,1 @@
+"""Studies made of many runs: sweeps, the stability suite, regression, benchmarks."""

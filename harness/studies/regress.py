@@ -1,0 +1,215 @@
+"""Regression check: a quick suite compared with a committed baseline, with stated tolerances.
+
+A baseline file (JSON, under ``reports/baselines/``) holds
+
+- ``suite``: the runs (id, scene, scene parameters, engine[preset], time step, horizon);
+- ``tolerances``: per metric name (and ``default``) an absolute and a relative tolerance with
+  the reason for them: a figure passes when |new - base| <= abs + rel |base|;
+- ``results``: per run id the baseline status, expectations verdict and metrics;
+- ``recorded``: revision and machine the results were recorded on.
+
+A regression is a changed status, a changed expectations verdict, a metric outside its
+tolerance, or a metric that disappeared. ``update`` rewrites ``results`` (and ``recorded``)
+from a fresh run, keeping the suite and tolerances.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import tempfile
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from pathlib import Path
+
+from clearbench.harness.run.engine_choice import RunInputError
+from clearbench.harness.run.runner import Runner
+from clearbench.harness.run.spec import RunSpec, make_run_spec
+from clearbench.harness.run.store import ResultsStore, machine_info, revision_info
+
+DEFAULT_BASELINE = Path("reports/baselines/quick.json")
+
+#: Suite written into a new baseline (smoke scenes, reference engine, short horizons).
+DEFAULT_SUITE = [
+    {"id": "bouncing-ball-e0.5", "scene": "bouncing-ball-e0.5", "engine": "reference",
+     "horizon": 1.0},
+    {"id": "incline-stick", "scene": "incline-stick", "engine": "reference", "horizon": 0.3},
+    {"id": "sliding-box", "scene": "sliding-box", "engine": "reference", "horizon": 0.5},
+    {"id": "pendulum", "scene": "pendulum", "engine": "reference", "horizon": 1.0},
+    # 0.1 s: covers the first impacts in the clearance, before the rattling motion amplifies
+    # round-off (a baseline must not depend on the last bit of the machine's arithmetic).
+    {"id": "clearance-pendulum", "scene": "clearance-pendulum", "engine": "reference",
+     "horizon": 0.1},
+]
+
+#: Tolerances written into a new baseline.
+DEFAULT_TOLERANCES = {
+    "default": {"abs": 1e-12, "rel": 1e-6,
+                "why": "the reference solver is deterministic; 1e-6 relative leaves room for "
+                "round-off differences of BLAS and compilers between machines of one kind"},
+    "solver_iterations_mean": {"abs": 0.5, "rel": 0.05,
+                               "why": "iteration counts move with round-off near the "
+                               "stopping tolerance"},
+    "solver_residual_max": {"abs": 1e-10, "rel": 10.0,
+                            "why": "residuals at convergence are round-off sized; only an "
+                            "order-of-magnitude change matters"},
+}
+
+
+@dataclass(frozen=True)
+class Tolerance:
+    absolute: float
+    relative: float
+    why: str = ""
+
+    def allows(self, base: float, new: float) -> bool:
+        if math.isnan(base) and math.isnan(new):
+            return True
+        if not (math.isfinite(base) and math.isfinite(new)):
+            return base == new
+        return abs(new - base) <= self.absolute + self.relative * abs(base)
+
+    def describe(self) -> str:
+        return f"{self.absolute:g} + {self.relative:g} x |base|"
+
+
+@dataclass
+class RegressOutcome:
+    """What a check found: regressions (one line each), notes, and the number of runs."""
+
+    regressions: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    runs: int = 0
+    compared_figures: int = 0
+
+
+def load_baseline(path: str | Path) -> dict:
+    path = Path(path)
+    if not path.exists():
+        return {"description": "Quick regression suite of clearbench (reference engine, smoke "
+                "scenes, short horizons).", "suite": DEFAULT_SUITE,
+                "tolerances": DEFAULT_TOLERANCES, "results": {}}
+    data = json.loads(path.read_text())
+    for key in ("suite", "tolerances"):
+        if key not in data:
+            raise RunInputError(f"{path}: {key}", None, "missing from the baseline file")
+    return data
+
+
+def suite_specs(baseline: dict, extra_modules: Mapping[str, str] | None = None) -> dict[
+        str, RunSpec]:
+    """Run id -> spec, validated (RunInputError naming the suite entry)."""
+    specs = {}
+    for index, entry in enumerate(baseline["suite"]):
+        ident = entry.get("id") or f"suite[{index}]"
+        try:
+            specs[ident] = make_run_spec(
+                entry["scene"], entry.get("engine", "reference"),
+                scene_parameters=entry.get("parameters"), time_step=entry.get("time_step"),
+                horizon=entry.get("horizon"), record_every=int(entry.get("record_every", 1)),
+                options=entry.get("options"), timeout=float(entry.get("timeout", 300)),
+                extra_engine_modules=extra_modules, campaign="regress")
+        except RunInputError as error:
+            raise RunInputError(f"suite entry {ident!r}: {error.field}", error.value,
+                                error.reason) from None
+    return specs
+
+
+def tolerance_for(baseline: dict, metric: str) -> Tolerance:
+    table = baseline["tolerances"]
+    entry = table.get(metric) or table.get("default") or {"abs": 0.0, "rel": 0.0}
+    return Tolerance(float(entry.get("abs", 0.0)), float(entry.get("rel", 0.0)),
+                     entry.get("why", ""))
+
+
+def _result_of(row: dict) -> dict:
+    passed = row["expectations_passed"]
+    return {"status": row["status"], "scene_hash": row["scene_hash"],
+            "expectations_passed": None if passed is None else int(passed),
+            "metrics": json.loads(row["metrics"] or "{}"),
+            "message": row["message"]}
+
+
+def run_suite(specs: dict[str, RunSpec], store_dir: str | Path | None = None,
+              jobs: int | None = None, runs_per_worker: int = 1,
+              progress: bool = False) -> dict[str, dict]:
+    """Run the suite (in a temporary store unless one is given) and return results by id."""
+    with tempfile.TemporaryDirectory(prefix="clearbench-regress-") as scratch:
+        store = ResultsStore(store_dir or scratch)
+        Runner(store, jobs=jobs, runs_per_worker=runs_per_worker,
+               progress=progress).run_all(list(specs.values()), rerun=store_dir is None)
+        return {ident: _result_of(store.get(spec.key)) for ident, spec in specs.items()}
+
+
+def compare(baseline: dict, results: dict[str, dict]) -> RegressOutcome:
+    """Every regression of ``results`` against ``baseline['results']``."""
+    outcome = RegressOutcome(runs=len(results))
+    base_results = baseline.get("results", {})
+    for ident, new in results.items():
+        base = base_results.get(ident)
+        if base is None:
+            outcome.regressions.append(f"{ident}: no baseline result (run with --update)")
+            continue
+        if base.get("scene_hash") and new.get("scene_hash") != base["scene_hash"]:
+            outcome.notes.append(f"{ident}: the scene definition changed since the baseline "
+                                 f"({base['scene_hash'][:12]} -> {new['scene_hash'][:12]}): "
+                                 "differences may come from the scene, not the solver")
+        if new["status"] != base["status"]:
+            outcome.regressions.append(f"{ident}: status {base['status']} -> {new['status']}"
+                                       + (f" ({new['message']})" if new["message"] else ""))
+        if new["expectations_passed"] != base.get("expectations_passed"):
+            outcome.regressions.append(f"{ident}: expectations passed "
+                                       f"{base.get('expectations_passed')} -> "
+                                       f"{new['expectations_passed']}")
+        for metric, base_value in sorted(base.get("metrics", {}).items()):
+            tolerance = tolerance_for(baseline, metric)
+            if metric not in new["metrics"]:
+                outcome.regressions.append(f"{ident}: {metric} no longer computed")
+                continue
+            value = float(new["metrics"][metric])
+            outcome.compared_figures += 1
+            base_number = _decode(base_value)
+            if not tolerance.allows(base_number, value):
+                outcome.regressions.append(
+                    f"{ident}: {metric} {base_number:.6g} -> {value:.6g} (tolerance "
+                    f"{tolerance.describe()})")
+        added = sorted(set(new["metrics"]) - set(base.get("metrics", {})))
+        if added:
+            outcome.notes.append(f"{ident}: new metrics not in the baseline: {', '.join(added)}")
+    for ident in sorted(set(base_results) - set(results)):
+        outcome.notes.append(f"{ident}: in the baseline results but not in the suite")
+    return outcome
+
+
+def _encode(value):
+    """Plain JSON for a figure: non-finite numbers as the strings 'nan', 'inf', '-inf'."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return str(value)
+    return value
+
+
+def _decode(value) -> float:
+    return float("nan") if value is None else float(value)
+
+
+def updated_baseline(baseline: dict, results: dict[str, dict]) -> dict:
+    """The baseline with ``results`` and ``recorded`` replaced."""
+    new = dict(baseline)
+    new["results"] = {
+        ident: {"status": result["status"], "scene_hash": result["scene_hash"],
+                "expectations_passed": result["expectations_passed"],
+                "metrics": {k: _encode(v) for k, v in sorted(result["metrics"].items())}}
+        for ident, result in results.items()}
+    revision = revision_info()
+    machine = machine_info()
+    new["recorded"] = {"revision": revision["revision"], "dirty": revision["dirty"],
+                       "machine": f"{machine['hostname']} ({machine['cpu']})",
+                       "date": datetime.now(UTC).isoformat(timespec="seconds")}
+    return new
+
+
+def write_baseline(path: str | Path, baseline: dict) -> None:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(baseline, indent=2, sort_keys=False, allow_nan=False) + "\n")

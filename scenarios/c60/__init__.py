@@ -1,0 +1,1 @@
+"""The Schneider Electric C-60 circuit-breaker mechanism: model, bench tests, CAD primitives."""

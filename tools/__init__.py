@@ -1,0 +1,1 @@
+"""Offline tools of the repository (tested in CI, not installed)."""

@@ -1,0 +1,1 @@
+"""Extraction of the C-60 contact primitives from its STEP files (needs OpenCASCADE)."""
