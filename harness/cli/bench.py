@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from clearbench.harness.cli import bench_against
 from clearbench.harness.cli.main import UserError
 
 
@@ -131,6 +132,7 @@ def register(subparsers) -> None:
     parser.add_argument("--out", help="where a benchmark writes its figure")
     parser.add_argument("--dt", nargs="+", help="time steps (scene units), where it applies")
     parser.add_argument("--tag", help="only scenes with this tag, where it applies")
+    bench_against.add_arguments(parser)
     parser.set_defaults(handler=run)
 
 
@@ -141,4 +143,6 @@ def run(args: argparse.Namespace) -> int:
         return 0
     if args.name not in BENCHMARKS:
         raise UserError(f"unknown benchmark {args.name!r}; benchmarks: {', '.join(BENCHMARKS)}")
+    if args.against:
+        return bench_against.run_against(args)
     return BENCHMARKS[args.name][0](args)

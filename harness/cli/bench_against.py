@@ -1,0 +1,66 @@
+"""``clearbench bench c60|reference --against REV``: a baseline revision and this one side by
+side, measured alternately in one session (:mod:`clearbench.harness.studies.against`)."""
+
+from __future__ import annotations
+
+import argparse
+
+from clearbench.harness.cli.main import UserError
+
+#: Cases of each benchmark that supports ``--against``: (scene, factory parameters, horizon
+#: [scene time unit; None: the scene's]); every preset of ``--presets`` runs each.
+CASES = {
+    "c60": (("c60-trip", {}, None), ("c60-on", {}, None)),
+    "reference": (("clearance-pendulum", {}, 1.0), ("box-grid", {"count": 30}, 0.2)),
+}
+DEFAULT_PRESETS = {"c60": ("default", "newton"), "reference": ("default",)}
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The options of ``--against`` on the ``bench`` parser."""
+    parser.add_argument("--against", metavar="REV",
+                        help="c60, reference: also run the baseline git revision REV, "
+                        "alternately with this one in one session, and print the ratio")
+    parser.add_argument("--repeat", type=int, default=2,
+                        help="--against: runs of each case on each side (best one kept)")
+    parser.add_argument("--horizon", type=float,
+                        help="--against: simulated time of each run (scene units; default the "
+                        "benchmark's)")
+    parser.add_argument("--presets", nargs="+", help="--against: reference presets")
+    parser.add_argument("--scenes", nargs="+", help="--against: only these scenes")
+
+
+def run_against(args: argparse.Namespace) -> int:
+    from clearbench.harness.studies.against import Case, resolve, side_by_side
+
+    if args.name not in CASES:
+        raise UserError(f"--against applies to {', '.join(CASES)}, not {args.name!r}")
+    try:
+        commit = resolve(args.against)
+    except ValueError as error:
+        raise UserError(str(error)) from error
+    if args.repeat < 1:
+        raise UserError(f"--repeat must be >= 1, got {args.repeat}")
+    presets = args.presets or DEFAULT_PRESETS[args.name]
+    cases = [Case(scene, preset, args.horizon or horizon, parameters)
+             for preset in presets for scene, parameters, horizon in CASES[args.name]
+             if not args.scenes or scene in args.scenes]
+    print(f"Reference engine, baseline {args.against} ({commit[:10]}) and this revision, "
+          f"alternately in one session, {args.repeat} run(s) of each on each side, best kept "
+          "(stepping wall time after a warm-up that compiles)")
+    print(f"{'scene':<19} {'preset':<8} {'steps':>6} {'base [s]':>9} {'this [s]':>9} "
+          f"{'speed-up':>8} {'base us/st':>10} {'this us/st':>10} {'unconv b/t':>11} "
+          f"{'iter/step b/t':>14}")
+
+    def report(pair) -> None:
+        b, c = pair.best_baseline, pair.best_current
+        steps = c["steps"]
+        print(f"{pair.case.scene:<19} {pair.case.preset:<8} {steps:>6} "
+              f"{b['stepping_seconds']:>9.2f} {c['stepping_seconds']:>9.2f} "
+              f"{pair.speedup:>8.2f} {1e6 * b['stepping_seconds'] / b['steps']:>10.1f} "
+              f"{1e6 * c['stepping_seconds'] / steps:>10.1f} "
+              f"{b['unconverged_steps']:>5}/{c['unconverged_steps']:<5} "
+              f"{b['mean_iterations']:>6.0f}/{c['mean_iterations']:<7.0f}", flush=True)
+
+    side_by_side(cases, args.against, args.repeat, report)
+    return 0

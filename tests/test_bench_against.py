@@ -1,0 +1,71 @@
+"""``clearbench bench c60|reference --against REV``: baseline export, worker protocol, ratio."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+from clearbench.harness.cli.main import main
+from clearbench.harness.studies import against
+
+
+def _run(**fields):
+    base = {"stepping_seconds": 1.0, "steps": 10, "unconverged_steps": 0,
+            "mean_iterations": 1.0}
+    return base | fields
+
+
+def test_pair_keeps_the_best_run_of_each_side_and_their_ratio():
+    pair = against.Pair(against.Case("ball"), [_run(stepping_seconds=4.0),
+                                               _run(stepping_seconds=3.0)],
+                        [_run(stepping_seconds=2.0), _run(stepping_seconds=1.5)])
+    assert pair.best_baseline["stepping_seconds"] == 3.0
+    assert pair.best_current["stepping_seconds"] == 1.5
+    assert pair.speedup == 2.0
+
+
+def test_unknown_revision_is_a_user_error(capsys):
+    assert main(["bench", "c60", "--against", "no-such-revision-anywhere"]) == 2
+    assert "does not know the revision" in capsys.readouterr().err
+
+
+def test_against_applies_to_c60_and_reference_only(capsys):
+    assert main(["bench", "clearance-ladder", "--against", "HEAD"]) == 2
+    assert "--against applies to" in capsys.readouterr().err
+
+
+def test_namespace_links_follow_the_package_dir_mapping(tmp_path):
+    source = tmp_path / "src"
+    (source / "clearbench").mkdir(parents=True)
+    (source / "clearbench" / "__init__.py").write_text("")
+    (source / "ref_solver").mkdir()
+    (source / "ref_solver" / "__init__.py").write_text("VALUE = 7\n")
+    (source / "pyproject.toml").write_text(
+        '[tool.setuptools]\npackage-dir = { "clearbench" = "clearbench", '
+        '"clearbench.ref_solver" = "ref_solver" }\n')
+    against._namespace_links(source, tmp_path / "shim")
+    out = subprocess.run([sys.executable, "-I", "-c",
+                          "import sys; sys.path.insert(0, sys.argv[1]); "
+                          "import clearbench.ref_solver as r; print(r.VALUE)",
+                          str(tmp_path / "shim")], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "7"
+    assert not (tmp_path / "shim" / "clearbench" / "ref_solver").readlink().is_absolute()
+
+
+def test_worker_answers_one_request_per_line():
+    request = against.Case("bouncing-ball-e0.5", horizon=0.01).request()
+    out = subprocess.run([sys.executable, "-P", str(against.WORKER)], input=request + "\n",
+                         capture_output=True, text=True, check=True, timeout=600)
+    reply = __import__("json").loads(out.stdout.splitlines()[0])
+    assert reply.get("error") is None, reply
+    assert reply["steps"] > 0 and reply["stepping_seconds"] > 0.0
+
+
+@pytest.mark.slow
+def test_side_by_side_against_head_runs_both_sides():
+    case = against.Case("bouncing-ball-e0.5", horizon=0.01)
+    pairs = against.side_by_side([case], "HEAD", repeat=2)
+    assert len(pairs[0].baseline) == len(pairs[0].current) == 2
+    assert pairs[0].best_baseline["steps"] == pairs[0].best_current["steps"]
