@@ -20,7 +20,6 @@ import math
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-from numba import njit
 
 from clearbench.ref_solver.contact_problem import (
     ContactProblem,
@@ -28,7 +27,21 @@ from clearbench.ref_solver.contact_problem import (
     SolverResult,
     SolverStatus,
 )
-from clearbench.ref_solver.fc3d_local import LOCAL_KIND, alart_curnier
+from clearbench.ref_solver.fc3d_local import LOCAL_KIND
+from clearbench.ref_solver.fc3d_newton_dense import solve_newton_dense
+from clearbench.ref_solver.fc3d_newton_parts import (
+    ARMIJO,
+    DELTA_MAX,
+    DELTA_MIN,
+    DENSE_LIMIT,
+    MAX_HALVINGS,
+    MAX_RESCUES,
+    RESCUE_SWEEPS,
+    alart_curnier_system,
+    bilateral_scalings,
+    contact_scalings,
+    dense_jacobian,
+)
 from clearbench.ref_solver.fc3d_nsgs import bilateral_operator_of, diagonal_blocks, nsgs_kernel
 from clearbench.ref_solver.fc3d_residual import (
     abs_operator_of,
@@ -39,80 +52,6 @@ from clearbench.ref_solver.fc3d_residual import (
 )
 
 logger = logging.getLogger(__name__)
-
-_ARMIJO = 1e-4
-_MAX_HALVINGS = 30
-_RESCUE_SWEEPS = 10
-_MAX_RESCUES = 50
-_DELTA_MIN = 1e-12
-_DENSE_LIMIT = 100  # rows; below, dense LU beats scipy.sparse overhead
-_DELTA_MAX = 1e-3
-
-
-@njit(cache=True)
-def alart_curnier_system(
-    r: np.ndarray, u: np.ndarray, mu: np.ndarray, n_bilateral: int, rho_n: np.ndarray,
-    rho_t: np.ndarray, rho_b: np.ndarray, phi: np.ndarray, A: np.ndarray, B: np.ndarray,
-    want_jacobian: bool,
-) -> float:
-    """Phi (m,) and the contact blocks A, B (nc, 3, 3) of its Jacobian; returns 0.5 |Phi|^2."""
-    merit = 0.0
-    for b in range(n_bilateral):
-        phi[b] = rho_b[b] * u[b]
-        merit += phi[b] * phi[b]
-    for i in range(mu.size):
-        k = n_bilateral + 3 * i
-        alart_curnier(r[k:k + 3], u[k:k + 3], mu[i], rho_n[i], rho_t[i], phi[k:k + 3], A[i],
-                      B[i], want_jacobian)
-        merit += phi[k] ** 2 + phi[k + 1] ** 2 + phi[k + 2] ** 2
-    return 0.5 * merit
-
-
-@njit(cache=True)
-def dense_jacobian(W: np.ndarray, n_bilateral: int, rho_b: np.ndarray, A: np.ndarray,
-                   B: np.ndarray, delta: float, J: np.ndarray) -> None:
-    """J = A + B W + delta I as a dense (m, m) array (A, B block diagonal, W dense)."""
-    m = W.shape[0]
-    for b in range(n_bilateral):
-        for col in range(m):
-            J[b, col] = rho_b[b] * W[b, col]
-        J[b, b] += delta
-    for i in range(A.shape[0]):
-        k = n_bilateral + 3 * i
-        for a in range(3):
-            for col in range(m):
-                J[k + a, col] = B[i, a, 0] * W[k, col] + B[i, a, 1] * W[k + 1, col] \
-                    + B[i, a, 2] * W[k + 2, col]
-            for c in range(3):
-                J[k + a, k + c] += A[i, a, c]
-            J[k + a, k + a] += delta
-
-
-@njit(cache=True)
-def _contact_scalings(blocks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """rho_N = 1 / W_ii[N, N], rho_T = 1 / max(W_ii[T1, T1], W_ii[T2, T2]) per contact, (nc,)
-    each (1 where the diagonal entry is not positive; rho_T falls back to rho_N)."""
-    nc = blocks.shape[0]
-    rho_n = np.ones(nc)
-    rho_t = np.ones(nc)
-    for i in range(nc):
-        w_nn = blocks[i, 0, 0]
-        w_tt = max(blocks[i, 1, 1], blocks[i, 2, 2])
-        if w_nn > 0.0:
-            rho_n[i] = 1.0 / w_nn
-        rho_t[i] = 1.0 / w_tt if w_tt > 0.0 else rho_n[i]
-    return rho_n, rho_t
-
-
-@njit(cache=True)
-def _bilateral_scalings(w_bb: np.ndarray) -> np.ndarray:
-    """rho_b = 1 / W_bb (1 where not positive), (nb,)."""
-    rho_b = np.ones(w_bb.size)
-    for b in range(w_bb.size):
-        if w_bb[b] > 0.0:
-            rho_b[b] = 1.0 / w_bb[b]
-    return rho_b
-
 
 def _block_diagonal(n_bilateral: int, bilateral_diagonal: np.ndarray, blocks: np.ndarray):
     """Sparse (m, m) matrix diag(bilateral_diagonal) ⊕ blocks[0] ⊕ ... ⊕ blocks[nc - 1]."""
@@ -127,7 +66,7 @@ def _block_diagonal(n_bilateral: int, bilateral_diagonal: np.ndarray, blocks: np
 
 def _regularised_direction_dense(W_dense, nb, rho_b, A, B, phi, residual, J):
     """Dense counterpart of :func:`_regularised_direction` (small problems)."""
-    delta = min(_DELTA_MAX, max(_DELTA_MIN, residual))
+    delta = min(DELTA_MAX, max(DELTA_MIN, residual))
     for _ in range(6):
         dense_jacobian(W_dense, nb, rho_b, A, B, delta, J)
         try:
@@ -149,7 +88,7 @@ def _regularised_direction(J, phi: np.ndarray, residual: float) -> np.ndarray | 
     fast local convergence) and grows when the factorisation fails.
     """
     identity = sp.identity(J.shape[0], format="csc")
-    delta = min(_DELTA_MAX, max(_DELTA_MIN, residual))
+    delta = min(DELTA_MAX, max(DELTA_MIN, residual))
     for _ in range(6):
         try:
             with np.errstate(all="ignore"):
@@ -163,14 +102,22 @@ def _regularised_direction(J, phi: np.ndarray, residual: float) -> np.ndarray | 
 
 
 def solve_newton(
-    problem: ContactProblem, options: SolverOptions, r0: np.ndarray | None = None
+    problem: ContactProblem, options: SolverOptions, r0: np.ndarray | None = None,
+    compiled: bool = True,
 ) -> SolverResult:
-    """Semismooth Newton solve of ``problem``; see ``solve_contact_problem``."""
+    """Semismooth Newton solve of ``problem``; see ``solve_contact_problem``.
+
+    Problems of at most ``DENSE_LIMIT`` rows are solved by the compiled kernel of
+    :mod:`fc3d_newton_dense` unless ``compiled`` is False (the Python driver below, kept as
+    the reference of the kernel's tests); larger ones by the Python driver with sparse LU.
+    """
+    if compiled and problem.size <= DENSE_LIMIT:
+        return solve_newton_dense(problem, options, r0)
     W = problem.W_csr()
     q, mu, nb, nc, m = problem.q, problem.mu, problem.n_bilateral, problem.n_contacts, problem.size
     use_max = options.use_max_normalisation
-    rho_n, rho_t = _contact_scalings(diagonal_blocks(W, nb, nc))
-    rho_b = _bilateral_scalings(W.diagonal()[:nb]) if nb else np.zeros(0)
+    rho_n, rho_t = contact_scalings(diagonal_blocks(W, nb, nc))
+    rho_b = bilateral_scalings(W.diagonal()[:nb]) if nb else np.zeros(0)
     r = np.zeros(m) if r0 is None else np.array(r0, dtype=np.float64, copy=True)
     if r.shape != (m,):
         raise ValueError(f"r0 must have shape ({m},), got {r.shape}")
@@ -180,7 +127,7 @@ def solve_newton(
     phi_try = np.zeros(m)
     A_try = np.zeros((nc, 3, 3))
     B_try = np.zeros((nc, 3, 3))
-    W_dense = problem.W_dense() if m <= _DENSE_LIMIT else None
+    W_dense = problem.W_dense() if m <= DENSE_LIMIT else None
     J_dense = np.empty((m, m)) if W_dense is not None else None
     history: list[float] = []
     rescues = 0
@@ -240,12 +187,12 @@ def solve_newton(
         if step_ok:
             step = 1.0
             step_ok = False
-            for _ in range(_MAX_HALVINGS):
+            for _ in range(MAX_HALVINGS):
                 r_try = r + step * d
                 u_try = W_product @ r_try + q
                 merit_try = alart_curnier_system(r_try, u_try, mu, nb, rho_n, rho_t, rho_b,
                                                  phi_try, A_try, B_try, False)
-                if merit_try <= (1.0 - 2.0 * _ARMIJO * step) * merit:
+                if merit_try <= (1.0 - 2.0 * ARMIJO * step) * merit:
                     step_ok = True
                     break
                 step *= 0.5
@@ -256,15 +203,15 @@ def solve_newton(
         else:
             # rescue: a few NSGS sweeps from the current iterate
             rescues += 1
-            if rescues > _MAX_RESCUES and residual >= best_residual:
+            if rescues > MAX_RESCUES and residual >= best_residual:
                 status = SolverStatus.STALLED
                 message = f"no descent direction after {rescues} NSGS rescues"
                 break
             u_tmp = np.empty(m)
             nsgs_kernel(W.indptr, W.indices, W.data, q, mu, nb, bilateral_operator_of(problem),
-                        r, u_tmp, LOCAL_KIND["ac"], options.tolerance, use_max, _RESCUE_SWEEPS,
-                        options.local_tolerance, options.local_max_iterations, _RESCUE_SWEEPS,
-                        np.full(_RESCUE_SWEEPS, np.nan), 0, 0)
+                        r, u_tmp, LOCAL_KIND["ac"], options.tolerance, use_max, RESCUE_SWEEPS,
+                        options.local_tolerance, options.local_max_iterations, RESCUE_SWEEPS,
+                        np.full(RESCUE_SWEEPS, np.nan), 0, 0)
         u, residual_q, residual_max, residual = measure(r, u_next)
         best_residual = min(best_residual, residual)
         history.append(residual)

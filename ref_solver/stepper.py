@@ -59,20 +59,20 @@ from clearbench.ref_solver.constraints import (
 from clearbench.ref_solver.contact_problem import ContactProblem, SolverOptions
 from clearbench.ref_solver.fc3d_solve import solve_contact_problem
 from clearbench.ref_solver.forces import (
-    applied_forces,
     no_angle_memory,
     remember_angles,
     rotation_matrices,
-    spring_jacobians,
 )
-from clearbench.ref_solver.gyroscopic import gyroscopic_update, integrate_orientations
+from clearbench.ref_solver.gyroscopic import integrate_orientations
 from clearbench.ref_solver.projection import solve_projection
+from clearbench.ref_solver.projection_kernel import (
+    MAX_PROJECTION_HALVINGS,
+    geometry_arrays,
+    project,
+)
+from clearbench.ref_solver.step_kernels import free_velocity, velocity_problem
 from clearbench.ref_solver.system import MultibodySystem, State
 from clearbench.scenarios.geometry import MAX_CONTACTS_PER_PAIR
-
-#: Halvings of a projection correction that does not reduce the largest violation before the
-#: projection gives up (a correction scaled by 2^-8 that still does not help is not a descent).
-MAX_PROJECTION_HALVINGS = 8
 
 
 @dataclass(frozen=True)
@@ -231,6 +231,10 @@ class MoreauJeanStepper:
         self.mass_matrix = mass_matrix
         self.inverse_mass = inverse
         self.projection_inverse = self._projection_metric_inverse(system)
+        self.geometry = geometry_arrays(system)
+        self.n_bilateral = system.bilateral_row_count
+        self.compiled_projection = True
+        self.has_springs = system.has_springs
         self._clusters(system)
         npair = system.pair_count
         k = MAX_CONTACTS_PER_PAIR
@@ -394,26 +398,12 @@ class MoreauJeanStepper:
         nu = np.concatenate((state.v, state.omega), axis=1)  # (nb, 6)
 
         # 1. Free velocity.
-        t_theta = state.t + theta * h
-        forces = applied_forces(t_theta, state.x, rotation, state.v, state.omega, sys_.mass,
-                                sys_.gravity, sys_.body_fixed, sys_.force_kind,
-                                sys_.force_body_a, sys_.force_body_b, sys_.force_parameters,
-                                self.angle_memory)
-        rhs = h * forces.ravel()
-        inverse = self.inverse_mass
-        if sys_.has_springs:
-            stiffness, damping = spring_jacobians(
-                t_theta, state.x, state.p, state.v, state.omega, sys_.body_fixed,
-                sys_.force_kind, sys_.force_body_a, sys_.force_body_b, sys_.force_parameters,
-                self.angle_memory, 1e-6 * cfg.length_scale)
-            iteration = self.mass_matrix - h * theta * damping - h * h * theta * theta * stiffness
-            rhs = rhs + h * h * theta * (stiffness @ nu.ravel())
-            inverse = self._cluster_inverse(iteration)
-        free = nu.ravel() + inverse @ rhs
-        omega_gyro, gyro_iterations = gyroscopic_update(
-            state.omega, sys_.inertia, sys_.inverse_inertia, sys_.body_fixed, h, theta)
-        free = free.reshape(-1, 6)
-        free[:, 3:] += omega_gyro - state.omega
+        free, inverse, gyro_iterations = free_velocity(
+            state.t + theta * h, h, theta, state.x, state.p, rotation, state.v, state.omega,
+            sys_.mass, sys_.inertia, sys_.inverse_inertia, sys_.gravity, sys_.body_fixed,
+            sys_.force_kind, sys_.force_body_a, sys_.force_body_b, sys_.force_parameters,
+            self.angle_memory, self.has_springs, 1e-6 * cfg.length_scale, self.mass_matrix,
+            self.inverse_mass, self.cluster_dofs, self.cluster_start)
 
         # Contacts at q_k and their normal velocities.
         cand = self._candidates(state.x, rotation)
@@ -550,19 +540,6 @@ class MoreauJeanStepper:
                 break
         return replace(best, iterations=iterations)
 
-    def _cluster_inverse(self, matrix: np.ndarray) -> np.ndarray:
-        out = np.zeros_like(matrix)
-        for c in range(len(self.cluster_start) - 1):
-            dofs = self.cluster_dofs[self.cluster_start[c]:self.cluster_start[c + 1]]
-            block = matrix[np.ix_(dofs, dofs)]
-            if not block.any():
-                continue
-            out[np.ix_(dofs, dofs)] = np.linalg.inv(block)
-        fixed = np.repeat(self.system.body_fixed, 6)
-        out[fixed, :] = 0.0
-        out[:, fixed] = 0.0
-        return out
-
     def _candidates(self, x, rotation):
         sys_ = self.system
         npair = sys_.pair_count
@@ -632,42 +609,30 @@ class MoreauJeanStepper:
         cfg = self.settings
         theta = cfg.theta
         t1 = state.t + h
-        # Joint Jacobians at the predicted configuration q_k + theta h v_k: with theta = 1/2
-        # this makes ideal joints second order in energy (at q_k the energy error is O(h)).
-        x_mid = state.x + theta * h * state.v
-        p_mid = integrate_orientations(state.p, theta * h * state.omega, sys_.body_fixed)
-        row_body, row_coef, _, target, pairs, slots = self._rows(
-            t1, state.x, state.p, rotation, cand, active,
-            bilateral_at=(x_mid, p_mid, rotation_matrices(p_mid)))
-        nbil = sys_.bilateral_row_count
-        m = row_body.shape[0]
+        pairs, slots = np.nonzero(self._slots(cand, active))
+        nbil = self.n_bilateral
+        m = nbil + 3 * len(pairs)
         new_nu = free.copy()
         impulses = np.zeros_like(self.previous_impulse)
         closed = np.zeros(active.shape, dtype=bool)
         if m:
-            w, y = delassus(row_body, row_coef, m, inverse, self.cluster,
-                            self.cluster_dofs, self.cluster_start)
-            q = row_values(row_body, row_coef, free, 0, m) - target
-            joint_rows = nbil - sys_.driver_body.shape[0]
-            impacting = np.zeros(len(pairs), dtype=bool)
-            if len(pairs):
-                u_k = row_values(row_body, row_coef, nu, nbil, m)[0::3]
-                e = sys_.pair_restitution[pairs]
-                # Newton's law only for impacts faster than the threshold (see settings).
-                impacting = u_k < -cfg.restitution_threshold
-            if joint_rows and cfg.joint_law == "midpoint" and not impacting.any():
-                # Ideal joints constrain the mid-step velocity, H_mid (theta v_{k+1} +
-                # (1 - theta) v_k) = 0: with constant forces the step then conserves energy
-                # exactly (v_mid . H^T lambda = 0), so the energy error of ideal joints is
-                # O(h^2) instead of the O(h) loss of H v_{k+1} = 0 (ENGINES.md, Siconos).
-                # In a step with an impact the motion is not smooth and the mid-step
-                # prediction of the Jacobian is off by O(h dv): there the joints take Moreau's
-                # law H v_{k+1} = 0, which cannot create energy (it did, by 1 % on the
-                # Flores slider-crank, with the mid-step law at impacts).
-                q[:joint_rows] += (1.0 - theta) / theta * row_values(
-                    row_body, row_coef, nu, 0, joint_rows)
-            if len(pairs):
-                q[nbil:][0::3] += np.where(impacting, e * u_k, 0.0)
+            # Joint Jacobians at the predicted configuration q_k + theta h v_k: with theta =
+            # 1/2 this makes ideal joints second order in energy (at q_k the energy error is
+            # O(h)). Ideal joints constrain the mid-step velocity, H_mid (theta v_{k+1} +
+            # (1 - theta) v_k) = 0: with constant forces the step then conserves energy
+            # exactly (v_mid . H^T lambda = 0), so the energy error of ideal joints is O(h^2)
+            # instead of the O(h) loss of H v_{k+1} = 0 (ENGINES.md, Siconos). In a step with
+            # an impact the motion is not smooth and the mid-step prediction of the Jacobian is
+            # off by O(h dv): there the joints take Moreau's law H v_{k+1} = 0, which cannot
+            # create energy (it did, by 1 % on the Flores slider-crank, with the mid-step law
+            # at impacts). Newton's law only for impacts faster than the threshold (see
+            # settings).
+            w, y, q, row_body, row_coef, _, _ = velocity_problem(
+                self.geometry, nbil, nbil - sys_.driver_body.shape[0], t1, h, theta, state.x,
+                state.p, state.v, state.omega, rotation, cand[1], cand[2], cand[3],
+                pairs.astype(np.int64), slots.astype(np.int64), nu, free, inverse,
+                self.cluster, self.cluster_dofs, self.cluster_start, sys_.pair_restitution,
+                cfg.restitution_threshold, cfg.joint_law == "midpoint")
             r0 = np.concatenate((self.previous_bilateral,
                                  self.previous_impulse[pairs, slots].ravel()))
             problem = ContactProblem(w, q, sys_.pair_friction[pairs], n_bilateral=nbil)
@@ -760,7 +725,18 @@ class MoreauJeanStepper:
                 values, n_equal, max(equal_error, unilateral_error))
 
     def _project(self, state: State, active, closed) -> tuple[int, float, bool]:
-        """Globalised Gauss–Newton projection (see :meth:`_projection_stage`)."""
+        """Globalised Gauss–Newton projection (see :meth:`_projection_stage`), compiled
+        (:func:`projection_kernel.project`) unless ``compiled_projection`` is False."""
+        if not self.compiled_projection:
+            return self._project_python(state, active, closed)
+        iterations, worst, converged = project(
+            self.geometry, self.n_bilateral, state.t, state.x, state.p, active, closed,
+            self.projection_inverse, *self.single_clusters, self.settings.position_tolerance,
+            self.settings.max_projection_iterations)
+        return int(iterations), float(worst), bool(converged)
+
+    def _project_python(self, state: State, active, closed) -> tuple[int, float, bool]:
+        """:meth:`_project` in Python and numpy (the reference of the compiled kernel)."""
         sys_ = self.system
         cfg = self.settings
         row_body, row_coef, values, n_equal, worst = self._violations(state, active, closed)

@@ -1,0 +1,111 @@
+"""Compiled dense linear algebra and residual kernels shared by the compiled solvers.
+
+Small dense problems (tens of rows): a product or a factorisation costs less than one call
+into numpy from Python, so the compiled one-step solvers do them here, in loops, without
+allocating beyond their outputs.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from clearbench.ref_solver.fc3d_residual import natural_map_squared, normalised
+
+
+@njit(cache=True)
+def matvec_plus(W: np.ndarray, x: np.ndarray, q: np.ndarray, out: np.ndarray) -> None:
+    """out = W x + q for a dense W (m, n), x (n,), q (m,) (in place)."""
+    for i in range(q.size):
+        acc = 0.0
+        for j in range(x.size):
+            acc += W[i, j] * x[j]
+        out[i] = acc + q[i]
+
+
+@njit(cache=True)
+def lu_solve(A: np.ndarray, b: np.ndarray, x: np.ndarray) -> bool:
+    """Solve A x = b (A (m, m), overwritten by its LU factors) by Gaussian elimination with
+    partial pivoting, as LAPACK's gesv; False when a pivot is exactly zero or x is not finite
+    (where ``numpy.linalg.solve`` raises or returns inf/nan)."""
+    m = b.size
+    for i in range(m):
+        x[i] = b[i]
+    for k in range(m):
+        pivot = k
+        largest = abs(A[k, k])
+        for i in range(k + 1, m):
+            if abs(A[i, k]) > largest:
+                largest = abs(A[i, k])
+                pivot = i
+        if largest == 0.0:
+            return False
+        if pivot != k:
+            for j in range(m):
+                A[k, j], A[pivot, j] = A[pivot, j], A[k, j]
+            x[k], x[pivot] = x[pivot], x[k]
+        inverse = 1.0 / A[k, k]
+        for i in range(k + 1, m):
+            factor = A[i, k] * inverse
+            if factor != 0.0:
+                for j in range(k + 1, m):
+                    A[i, j] -= factor * A[k, j]
+                x[i] -= factor * x[k]
+    for k in range(m - 1, -1, -1):
+        acc = x[k]
+        for j in range(k + 1, m):
+            acc -= A[k, j] * x[j]
+        x[k] = acc / A[k, k]
+        if not math.isfinite(x[k]):
+            return False
+    return True
+
+
+@njit(cache=True)
+def residuals(r: np.ndarray, u: np.ndarray, q: np.ndarray, mu: np.ndarray,
+              n_bilateral: int) -> tuple[float, float, float]:
+    """(|F|, |F| / |q|, |F| / max(|q|, |r|, |u|)) of r with u = W r + q (as
+    :func:`fc3d_residual.residual_both`)."""
+    abs_residual = math.sqrt(natural_map_squared(r, u, mu, n_bilateral))
+    norm_q = math.sqrt(np.dot(q, q))
+    norm_r = math.sqrt(np.dot(r, r))
+    norm_u = math.sqrt(np.dot(u, u))
+    return (abs_residual, normalised(abs_residual, norm_q, norm_r, norm_u, False),
+            normalised(abs_residual, norm_q, norm_r, norm_u, True))
+
+
+@njit(cache=True)
+def roundoff_floor_dense(W: np.ndarray, r: np.ndarray, u: np.ndarray, q: np.ndarray,
+                         mu: np.ndarray, use_max: bool) -> float:
+    """:func:`fc3d_residual.roundoff_floor` for a dense W (m, m), without forming |W|."""
+    m = q.size
+    eps = 2.220446049250313e-16
+    gamma = (m + 1) * eps / (1.0 - (m + 1) * eps)
+    total = 0.0
+    for i in range(m):
+        acc = 0.0
+        for j in range(m):
+            acc += abs(W[i, j]) * abs(r[j])
+        acc += abs(q[i])
+        total += acc * acc
+    largest_mu = 0.0
+    for i in range(mu.size):
+        largest_mu = max(largest_mu, mu[i])
+    norm_r = math.sqrt(np.dot(r, r))
+    bound = (1.0 + largest_mu) * gamma * math.sqrt(total) + 2.0 * eps * norm_r
+    return normalised(bound, math.sqrt(np.dot(q, q)), norm_r, math.sqrt(np.dot(u, u)), use_max)
+
+
+@njit(cache=True)
+def bilateral_operator_dense(W: np.ndarray, n_bilateral: int) -> np.ndarray:
+    """:func:`fc3d_nsgs.bilateral_solve_operator` of the leading (nb, nb) block of a dense W:
+    its inverse when cond < 1e12, else its pseudo-inverse (rcond 1e-12)."""
+    if n_bilateral == 0:
+        return np.zeros((0, 0))
+    block = np.ascontiguousarray(W[:n_bilateral, :n_bilateral])
+    condition = np.linalg.cond(block)
+    if math.isfinite(condition) and condition < 1e12:
+        return np.linalg.inv(block)
+    return np.linalg.pinv(block, rcond=1e-12)

@@ -1,0 +1,235 @@
+"""The projection stage of the combined projection scheme, compiled whole.
+
+The same Gauss–Newton projection as ``MoreauJeanStepper._project`` (rows of the joints,
+drivers and active contacts at the current configuration; contacts that carry an impulse as
+equalities, the others unilateral; the multipliers of the mixed LCP by the active-set method
+of :func:`projection.solve_projection`; the correction dq = Mp^-1 H^T delta halved until the
+largest violation decreases), with the candidates, the rows, the Delassus operator, the
+least-squares solves and the orientation update in one numba call per projection.
+
+The system's arrays travel as one tuple, :func:`geometry_arrays` (the order is the argument
+order of :func:`constraints.contact_candidates` and :func:`constraints.bilateral_rows`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from clearbench.ref_solver.constraints import (
+    bilateral_rows,
+    contact_candidates,
+    contact_rows,
+    delassus,
+)
+from clearbench.ref_solver.forces import rotation_matrices
+from clearbench.ref_solver.gyroscopic import integrate_orientations
+from clearbench.scenarios.geometry import MAX_CONTACTS_PER_PAIR
+
+#: Halvings of a projection correction that does not reduce the largest violation before the
+#: projection gives up (a correction scaled by 2^-8 that still does not help is not a descent).
+MAX_PROJECTION_HALVINGS = 8
+#: Active-set iterations of the multipliers' mixed LCP.
+MAX_ACTIVE_SET_ITERATIONS = 50
+
+
+def geometry_arrays(system) -> tuple:
+    """The arrays of ``system`` (a :class:`~.system.MultibodySystem`) that the compiled rows
+    and candidates need, as one tuple (see the module docstring)."""
+    s = system
+    return (s.body_fixed, s.shape_kind, s.shape_parameters, s.shape_body, s.shape_position,
+            s.shape_rotation, s.pair_shape_a, s.pair_shape_b, s.pair_offset, s.joint_kind,
+            s.joint_body_a, s.joint_body_b, s.joint_anchor_a, s.joint_anchor_b,
+            s.joint_frame_a, s.joint_axis_b, s.joint_relative_rotation, s.driver_body,
+            s.driver_component, s.driver_quantity, s.driver_start, s.driver_times,
+            s.driver_values, s.driver_initial, s.driver_reference)
+
+
+@njit(cache=True)
+def candidates(arrays, x, rotation):
+    """Every pair's contact candidates at (x (nb, 3), rotation (nb, 3, 3)): (gap (npair, K),
+    point_a, point_b (npair, K, 3), frame (npair, K, 3, 3), count (npair,)), as
+    ``MoreauJeanStepper._candidates``."""
+    npair = arrays[6].shape[0]
+    k = MAX_CONTACTS_PER_PAIR
+    gap = np.full((npair, k), np.inf)
+    point_a = np.zeros((npair, k, 3))
+    point_b = np.zeros((npair, k, 3))
+    frame = np.zeros((npair, k, 3, 3))
+    count = np.zeros(npair, dtype=np.int64)
+    if npair:
+        contact_candidates(x, rotation, arrays[1], arrays[2], arrays[3], arrays[4], arrays[5],
+                           arrays[6], arrays[7], arrays[8], gap, point_a, point_b, frame, count)
+    return gap, point_a, point_b, frame, count
+
+
+@njit(cache=True)
+def projection_rows(arrays, n_bilateral, t, x, p, active, closed):
+    """Rows of the projection at (x, p): (row_body (m, 2), row_coef (m, 2, 6), values (m,)
+    [L], n_equal, worst [L]), as ``MoreauJeanStepper._violations``: bilateral rows and the
+    normal rows of the active contacts that hold a candidate here, equalities (bilateral rows,
+    contacts in ``closed``) first, then the unilateral rows, each group in row order; ``worst``
+    is the largest equality violation or penetration."""
+    rotation = rotation_matrices(p)
+    gap, point_a, point_b, frame, count = candidates(arrays, x, rotation)
+    npair = gap.shape[0]
+    n_selected = 0
+    for k in range(npair):
+        for s in range(gap.shape[1]):
+            if active[k, s] and s < count[k]:
+                n_selected += 1
+    pairs = np.empty(n_selected, dtype=np.int64)
+    slots = np.empty(n_selected, dtype=np.int64)
+    c = 0
+    for k in range(npair):
+        for s in range(gap.shape[1]):
+            if active[k, s] and s < count[k]:
+                pairs[c] = k
+                slots[c] = s
+                c += 1
+    m_all = n_bilateral + 3 * n_selected
+    body_all = np.full((m_all, 2), -1, dtype=np.int64)
+    coef_all = np.zeros((m_all, 2, 6))
+    violation = np.zeros(m_all)
+    if n_bilateral:
+        target = np.zeros(m_all)
+        bilateral_rows(t, x, p, rotation, arrays[0], arrays[9], arrays[10], arrays[11],
+                       arrays[12], arrays[13], arrays[14], arrays[15], arrays[16], arrays[17],
+                       arrays[18], arrays[19], arrays[20], arrays[21], arrays[22], arrays[23],
+                       arrays[24], body_all, coef_all, violation, target)
+    if n_selected:
+        contact_rows(x, rotation, arrays[0], arrays[3], arrays[6], arrays[7], pairs, slots,
+                     point_a, point_b, frame, body_all, coef_all, n_bilateral)
+    n_equal = n_bilateral
+    for c in range(n_selected):
+        if closed[pairs[c], slots[c]]:
+            n_equal += 1
+    m = n_bilateral + n_selected
+    order = np.empty(m, dtype=np.int64)
+    values = np.empty(m)
+    for i in range(n_bilateral):
+        order[i] = i
+        values[i] = violation[i]
+    equal_fill = n_bilateral
+    unilateral_fill = n_equal
+    for c in range(n_selected):
+        value = gap[pairs[c], slots[c]]
+        if closed[pairs[c], slots[c]]:
+            order[equal_fill] = n_bilateral + 3 * c
+            values[equal_fill] = value
+            equal_fill += 1
+        else:
+            order[unilateral_fill] = n_bilateral + 3 * c
+            values[unilateral_fill] = value
+            unilateral_fill += 1
+    worst = 0.0
+    for i in range(n_equal):
+        worst = max(worst, abs(values[i]))
+    for i in range(n_equal, m):
+        worst = max(worst, -values[i])
+    row_body = np.empty((m, 2), dtype=np.int64)
+    row_coef = np.empty((m, 2, 6))
+    for i in range(m):
+        row_body[i] = body_all[order[i]]
+        row_coef[i] = coef_all[order[i]]
+    return row_body, row_coef, values, n_equal, worst
+
+
+@njit(cache=True)
+def active_set_multipliers(W, b, n_equal, tolerance, max_iterations):
+    """:func:`projection.solve_projection` compiled: (delta (m,), converged)."""
+    m = b.shape[0]
+    active = np.zeros(m, dtype=np.bool_)
+    for i in range(m):
+        active[i] = i < n_equal or b[i] < 0.0
+    delta = np.zeros(m)
+    for _ in range(max_iterations):
+        delta[:] = 0.0
+        n_active = 0
+        for i in range(m):
+            if active[i]:
+                n_active += 1
+        if n_active:
+            idx = np.empty(n_active, dtype=np.int64)
+            c = 0
+            for i in range(m):
+                if active[i]:
+                    idx[c] = i
+                    c += 1
+            sub = np.empty((n_active, n_active))
+            rhs = np.empty(n_active)
+            for a in range(n_active):
+                rhs[a] = -b[idx[a]]
+                for c in range(n_active):
+                    sub[a, c] = W[idx[a], idx[c]]
+            solution = np.linalg.lstsq(sub, rhs, rcond=1e-12)[0]
+            for a in range(n_active):
+                delta[idx[a]] = solution[a]
+        # Drop the unilateral row that pulls most (negative multiplier), if any.
+        pulling = -1
+        for i in range(n_equal, m):
+            if active[i] and delta[i] < 0.0 and (pulling < 0 or delta[i] < delta[pulling]):
+                pulling = i
+        if pulling >= 0:
+            active[pulling] = False
+            continue
+        violated = -1
+        worst = 0.0
+        for i in range(n_equal, m):
+            if active[i]:
+                continue
+            w_i = b[i]
+            for j in range(m):
+                w_i += W[i, j] * delta[j]
+            if w_i < -tolerance and (violated < 0 or w_i < worst):
+                violated = i
+                worst = w_i
+        if violated < 0:
+            return delta, True
+        active[violated] = True
+    return delta, False
+
+
+@njit(cache=True)
+def project(arrays, n_bilateral, t, x, p, active, closed, metric_inverse, cluster,
+            cluster_dofs, cluster_start, position_tolerance, max_iterations):
+    """Globalised Gauss–Newton projection of (x (nb, 3), p (nb, 4)) in place (see the module
+    docstring); returns (iterations, largest remaining violation [L], converged)."""
+    fixed = arrays[0]
+    nb = x.shape[0]
+    row_body, row_coef, values, n_equal, worst = projection_rows(
+        arrays, n_bilateral, t, x, p, active, closed)
+    for iteration in range(max_iterations + 1):
+        if worst <= position_tolerance or values.size == 0:
+            return iteration, worst, True
+        if iteration == max_iterations:
+            break
+        m = values.size
+        w, y = delassus(row_body, row_coef, m, metric_inverse, cluster, cluster_dofs,
+                        cluster_start)
+        multipliers, _ = active_set_multipliers(w, values, n_equal, 0.1 * position_tolerance,
+                                                MAX_ACTIVE_SET_ITERATIONS)
+        delta = np.zeros((nb, 6))
+        for b in range(nb):
+            for i in range(6):
+                acc = 0.0
+                for j in range(m):
+                    acc += y[6 * b + i, j] * multipliers[j]
+                delta[b, i] = acc
+        x0 = x.copy()
+        p0 = p.copy()
+        improved = False
+        for _ in range(MAX_PROJECTION_HALVINGS + 1):
+            x[:] = x0 + delta[:, :3]
+            p[:] = integrate_orientations(p0, np.ascontiguousarray(delta[:, 3:]), fixed)
+            trial = projection_rows(arrays, n_bilateral, t, x, p, active, closed)
+            if trial[4] < worst:
+                improved = True
+                break
+            delta *= 0.5
+        if not improved:
+            x[:] = x0
+            p[:] = p0
+            return iteration + 1, worst, False
+        row_body, row_coef, values, n_equal, worst = trial
+    return max_iterations, worst, False
