@@ -62,4 +62,4 @@ clean:
 # kernel edited in another module): after editing numba kernels, drop the caches.
 clean-numba-cache:
 	find . -not -path './$(VENV)/*' \( -name '*.nbi' -o -name '*.nbc' \) -delete
-	rm -rf $${XDG_CACHE_HOME:-$$HOME/.cache}/clearbench-numba
+	rm -rf $${XDG_CACHE_HOME:-$$HOME/.cache}/clearbench-numba $${XDG_CACHE_HOME:-$$HOME/.cache}/clearbench-numba-checkouts

@@ -69,7 +69,12 @@ _KEEP_CACHES = 4
 def _set_numba_cache_dir() -> None:
     if os.environ.get("NUMBA_CACHE_DIR"):
         return
-    root = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "clearbench-numba"
+    # One folder per checkout: the pruning below must not delete the live cache of another
+    # checkout (worktrees working side by side recompiled every kernel, or crashed on a cache
+    # file removed under them, when they shared one folder).
+    checkout = hashlib.sha1(str(Path(__file__).resolve().parent.parent).encode()).hexdigest()
+    root = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) \
+        / "clearbench-numba-checkouts" / checkout[:12]
     current = root / _sources_fingerprint()
     os.environ["NUMBA_CACHE_DIR"] = str(current)
     try:
