@@ -51,7 +51,6 @@ import numpy as np
 
 from clearbench.ref_solver.constraints import (
     bilateral_rows,
-    contact_candidates,
     contact_rows,
     delassus,
     row_values,
@@ -67,6 +66,7 @@ from clearbench.ref_solver.gyroscopic import integrate_orientations
 from clearbench.ref_solver.projection import solve_projection
 from clearbench.ref_solver.projection_kernel import (
     MAX_PROJECTION_HALVINGS,
+    candidates,
     geometry_arrays,
     project,
 )
@@ -541,20 +541,8 @@ class MoreauJeanStepper:
         return replace(best, iterations=iterations)
 
     def _candidates(self, x, rotation):
-        sys_ = self.system
-        npair = sys_.pair_count
-        k = MAX_CONTACTS_PER_PAIR
-        gap = np.full((npair, k), np.inf)
-        point_a = np.zeros((npair, k, 3))
-        point_b = np.zeros((npair, k, 3))
-        frame = np.zeros((npair, k, 3, 3))
-        count = np.zeros(npair, dtype=np.int64)
-        if npair:
-            contact_candidates(x, rotation, sys_.shape_kind, sys_.shape_parameters,
-                               sys_.shape_body, sys_.shape_position, sys_.shape_rotation,
-                               sys_.pair_shape_a, sys_.pair_shape_b, sys_.pair_offset, gap,
-                               point_a, point_b, frame, count)
-        return gap, point_a, point_b, frame, count
+        """(gap, point_a, point_b, frame, count) of every pair at (x, rotation)."""
+        return candidates(self.geometry, x, rotation)
 
     @staticmethod
     def _slots(cand, mask):
