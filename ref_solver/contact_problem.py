@@ -153,10 +153,20 @@ class ContactProblem:
     def _csr(self) -> sp.csr_matrix:
         if sp.issparse(self.W):
             return self.W
+        return sp.csr_matrix(self._csr_arrays, shape=self.W.shape)
+
+    @functools.cached_property
+    def _csr_arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        if sp.issparse(self.W):
+            return self.W.data, self.W.indices, self.W.indptr
         # Compiled conversion: scipy's csr_matrix(dense) costs ~100 us for small matrices,
-        # more than a whole NSGS solve of a few contacts.
-        data, indices, indptr = _dense_to_csr(self.W)
-        return sp.csr_matrix((data, indices, indptr), shape=self.W.shape)
+        # more than a whole NSGS solve of a few contacts (and even wrapping the arrays in a
+        # csr_matrix costs tens of us: the compiled solvers take the arrays).
+        return _dense_to_csr(self.W)
+
+    def W_csr_arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(data, indices, indptr) of W in CSR form; computed once. Do not modify."""
+        return self._csr_arrays
 
     @functools.cached_property
     def _dense(self) -> np.ndarray:

@@ -201,13 +201,13 @@ def solve_nsgs(
     method = _METHOD_NAMES[options.local_solver]
     if m == 0:
         return SolverResult(r, r.copy(), 0, 0.0, 0.0, 0.0, True, SolverStatus.CONVERGED, method)
-    W = problem.W_csr()
+    data, indices, indptr = problem.W_csr_arrays()
     u = np.empty(m)
     history = np.empty(options.max_iterations)  # untouched pages cost nothing
     use_max = options.use_max_normalisation
     nb = problem.n_bilateral
     code, sweeps, residual_q, residual_max, failures, n_checks = nsgs_kernel(
-        W.indptr, W.indices, W.data, problem.q, problem.mu, nb,
+        indptr, indices, data, problem.q, problem.mu, nb,
         bilateral_operator_of(problem) if nb else _NO_OPERATOR, r, u,
         LOCAL_KIND[options.local_solver],
         options.tolerance, use_max, options.max_iterations, options.local_tolerance,

@@ -235,6 +235,13 @@ class MoreauJeanStepper:
         self.n_bilateral = system.bilateral_row_count
         self.compiled_projection = True
         self.has_springs = system.has_springs
+        # (the method's own options, hybrid's Newton, its first NSGS, its full NSGS)
+        solver = settings.solver
+        self._solver_options = (
+            replace(solver, method=settings.method) if settings.method != "hybrid" else None,
+            replace(solver, method="newton", max_iterations=200),
+            replace(solver, method="nsgs", max_iterations=settings.hybrid_sweeps),
+            replace(solver, method="nsgs"))
         self._clusters(system)
         npair = system.pair_count
         k = MAX_CONTACTS_PER_PAIR
@@ -507,9 +514,9 @@ class MoreauJeanStepper:
         Newton can stall from a poor start, while another start converges in a few iterations.
         """
         cfg = self.settings
+        single, newton, nsgs_first_options, nsgs = self._solver_options
         if cfg.method != "hybrid":
-            return solve_contact_problem(problem, replace(cfg.solver, method=cfg.method), r0=r0)
-        newton = replace(cfg.solver, method="newton", max_iterations=200)
+            return solve_contact_problem(problem, single, r0=r0)
         iterations = 0
         if self._newton_first:
             # The last problem needed Newton: consecutive steps' problems are alike (the same
@@ -519,15 +526,13 @@ class MoreauJeanStepper:
             if best.converged:
                 return best
             iterations = best.iterations
-        nsgs_first = solve_contact_problem(
-            problem, replace(cfg.solver, method="nsgs", max_iterations=cfg.hybrid_sweeps), r0=r0)
+        nsgs_first = solve_contact_problem(problem, nsgs_first_options, r0=r0)
         iterations += nsgs_first.iterations
         if nsgs_first.converged:
             self._newton_first = False
             return replace(nsgs_first, iterations=iterations)
         if not self._newton_first or nsgs_first.residual < best.residual:
             best = nsgs_first
-        nsgs = replace(cfg.solver, method="nsgs")
         attempts = ((newton, nsgs_first.r), (newton, r0), (newton, None), (nsgs, None),
                     (nsgs, nsgs_first.r))
         for options, start in attempts:
