@@ -209,8 +209,9 @@ def profile_displacement(times, values, quantity, t):
 @njit(cache=True)
 def contact_candidates(x, rotation, shape_kind, shape_parameters, shape_body, shape_position,
                        shape_rotation, pair_a, pair_b, pair_offset, gap, point_a, point_b,
-                       frame, count):
-    """Evaluate every contact pair: up to MAX_CONTACTS_PER_PAIR candidates each.
+                       frame, count, selected):
+    """Evaluate every contact pair with ``selected`` (npair,) bool set: up to
+    MAX_CONTACTS_PER_PAIR candidates each (the outputs of the others are left as they are).
 
     Outputs (npair, K, ...) arrays: ``gap`` = geometric gap - offset, world points, contact
     frames (rows n, t1, t2; n from A toward B); ``count`` (npair,). The offset is taken on A's
@@ -219,6 +220,8 @@ def contact_candidates(x, rotation, shape_kind, shape_parameters, shape_body, sh
     friction forces, a distance ``offset`` apart, would exert a spurious moment).
     """
     for k in range(pair_a.shape[0]):
+        if not selected[k]:
+            continue
         sa = pair_a[k]
         sb = pair_b[k]
         ba = shape_body[sa]

@@ -48,8 +48,14 @@ def geometry_arrays(system) -> tuple:
 @njit(cache=True)
 def candidates(arrays, x, rotation):
     """Every pair's contact candidates at (x (nb, 3), rotation (nb, 3, 3)): (gap (npair, K),
-    point_a, point_b (npair, K, 3), frame (npair, K, 3, 3), count (npair,)), as
-    ``MoreauJeanStepper._candidates``."""
+    point_a, point_b (npair, K, 3), frame (npair, K, 3, 3), count (npair,))."""
+    return selected_candidates(arrays, x, rotation, np.ones(arrays[6].shape[0], np.bool_))
+
+
+@njit(cache=True)
+def selected_candidates(arrays, x, rotation, selected):
+    """:func:`candidates` of the pairs with ``selected`` (npair,) bool set; the others have no
+    candidate (count 0, gap inf)."""
     npair = arrays[6].shape[0]
     k = MAX_CONTACTS_PER_PAIR
     gap = np.full((npair, k), np.inf)
@@ -59,7 +65,8 @@ def candidates(arrays, x, rotation):
     count = np.zeros(npair, dtype=np.int64)
     if npair:
         contact_candidates(x, rotation, arrays[1], arrays[2], arrays[3], arrays[4], arrays[5],
-                           arrays[6], arrays[7], arrays[8], gap, point_a, point_b, frame, count)
+                           arrays[6], arrays[7], arrays[8], gap, point_a, point_b, frame, count,
+                           selected)
     return gap, point_a, point_b, frame, count
 
 
@@ -71,8 +78,13 @@ def projection_rows(arrays, n_bilateral, t, x, p, active, closed):
     contacts in ``closed``) first, then the unilateral rows, each group in row order; ``worst``
     is the largest equality violation or penetration."""
     rotation = rotation_matrices(p)
-    gap, point_a, point_b, frame, count = candidates(arrays, x, rotation)
-    npair = gap.shape[0]
+    # Only the pairs with an active slot make rows: the others are not evaluated.
+    npair = active.shape[0]
+    selected = np.zeros(npair, dtype=np.bool_)
+    for k in range(npair):
+        for s in range(active.shape[1]):
+            selected[k] = selected[k] or active[k, s]
+    gap, point_a, point_b, frame, count = selected_candidates(arrays, x, rotation, selected)
     n_selected = 0
     for k in range(npair):
         for s in range(gap.shape[1]):
