@@ -52,6 +52,7 @@ class Normalisation(enum.Enum):
 
 
 METHODS = ("nsgs", "newton")
+NEWTON_DIRECTIONS = ("regularised", "least_norm")
 
 
 @njit(cache=True)
@@ -248,6 +249,11 @@ class SolverOptions:
         (:func:`fc3d_residual.hopeless`). A solve stopped so could at best have converged by a
         late acceleration; the reference stepper uses it (NSGS crawling at 1e-8 on a singular W
         would otherwise run its 10,000 sweeps before the next start is tried).
+    newton_direction : {"regularised", "least_norm"}
+        Newton only. "regularised": (J + delta I) d = -Phi, delta from the residual;
+        "least_norm": the minimum-norm least-squares solution of J d = -Phi (dense, compiled),
+        which converges where redundant contacts make J singular and the regularised direction
+        crawls (:func:`fc3d_newton_dense.least_norm_direction`).
     stall_after : int
         No early stop before this many checks (NSGS) or iterations (Newton): NSGS may sit on a
         plateau for hundreds of sweeps until the contact statuses settle, then converge at
@@ -265,10 +271,14 @@ class SolverOptions:
     roundoff_floor: bool = False
     stall_window: int = 0
     stall_after: int = 0
+    newton_direction: str = "regularised"
 
     def __post_init__(self) -> None:
         if self.method not in METHODS:
             raise ValueError(f"method must be one of {METHODS}, got {self.method!r}")
+        if self.newton_direction not in NEWTON_DIRECTIONS:
+            raise ValueError(f"newton_direction must be one of {NEWTON_DIRECTIONS}, got "
+                             f"{self.newton_direction!r}")
         if self.local_solver not in LOCAL_SOLVERS:
             raise ValueError(
                 f"local_solver must be one of {LOCAL_SOLVERS}, got {self.local_solver!r}"

@@ -109,9 +109,10 @@ def solve_newton(
 
     Problems of at most ``DENSE_LIMIT`` rows are solved by the compiled kernel of
     :mod:`fc3d_newton_dense` unless ``compiled`` is False (the Python driver below, kept as
-    the reference of the kernel's tests); larger ones by the Python driver with sparse LU.
+    the reference of the kernel's tests); larger ones by the Python driver with sparse LU,
+    except with the least-norm direction, which only the dense kernel has.
     """
-    if compiled and problem.size <= DENSE_LIMIT:
+    if options.newton_direction == "least_norm" or (compiled and problem.size <= DENSE_LIMIT):
         return solve_newton_dense(problem, options, r0)
     W = problem.W_csr()
     q, mu, nb, nc, m = problem.q, problem.mu, problem.n_bilateral, problem.n_contacts, problem.size

@@ -77,10 +77,33 @@ def regularised_direction(W, n_bilateral, rho_b, A, B, phi, residual, J, d) -> b
 
 
 @njit(cache=True)
+def least_norm_direction(W, n_bilateral, rho_b, A, B, phi, J, d) -> bool:
+    """d = the minimum-norm least-squares solution of J d = -Phi (singular values below 1e-10
+    of the largest dropped); False if it is not finite.
+
+    Redundant contacts (two rings of one journal, closed together) make W, hence J, singular
+    with a null space of impulse distributions that change no velocity. The regularised
+    direction then mixes a huge null-space component into the step and the line search crawls
+    (thousands of iterations from 1e-9 to 1e-12); the least-norm direction leaves the null
+    space alone and keeps Newton's convergence on the rest.
+    """
+    dense_jacobian(W, n_bilateral, rho_b, A, B, 0.0, J)
+    solution = np.linalg.lstsq(J, -phi, rcond=1e-10)[0]
+    for i in range(d.size):
+        d[i] = solution[i]
+        if not math.isfinite(d[i]):
+            return False
+    return True
+
+
+@njit(cache=True)
 def newton_dense_kernel(W, q, mu, n_bilateral, r, u, tolerance, use_max, max_iterations,
                         use_floor, stall_window, stall_after, local_tolerance,
-                        local_max_iterations, history):
+                        local_max_iterations, history, least_norm=False):
     """Semismooth Newton on the dense problem (W (m, m), q (m,), mu (nc,), n_bilateral).
+
+    The direction is :func:`regularised_direction`, or :func:`least_norm_direction` with
+    ``least_norm``.
 
     ``r`` (m,) is the start and receives the result, ``u`` (m,) receives W r + q, ``history``
     (>= max_iterations,) the tested residual after each iteration. Returns (status code,
@@ -141,7 +164,10 @@ def newton_dense_kernel(W, q, mu, n_bilateral, r, u, tolerance, use_max, max_ite
         iteration += 1
         merit = alart_curnier_system(r, u, mu, n_bilateral, rho_n, rho_t, rho_b, phi, A, B,
                                      True)
-        step_ok = regularised_direction(W, n_bilateral, rho_b, A, B, phi, residual, J, d)
+        if least_norm:
+            step_ok = least_norm_direction(W, n_bilateral, rho_b, A, B, phi, J, d)
+        else:
+            step_ok = regularised_direction(W, n_bilateral, rho_b, A, B, phi, residual, J, d)
         if step_ok:
             step = 1.0
             step_ok = False
@@ -194,7 +220,8 @@ def solve_newton_dense(problem: ContactProblem, options: SolverOptions,
                             u, options.tolerance, options.use_max_normalisation,
                             options.max_iterations, options.roundoff_floor,
                             options.stall_window, options.stall_after, options.local_tolerance,
-                            options.local_max_iterations, history)
+                            options.local_max_iterations, history,
+                            options.newton_direction == "least_norm")
     status = _STATUS[code]
     message = ""
     if code == ROUNDOFF:

@@ -235,19 +235,21 @@ class MoreauJeanStepper:
         self.n_bilateral = system.bilateral_row_count
         self.compiled_projection = True
         self.has_springs = system.has_springs
-        # (the method's own options, hybrid's Newton, its first NSGS, its full NSGS)
+        # (the method's own options, hybrid's Newton, its first NSGS, its full NSGS, its
+        # least-norm Newton)
         solver = settings.solver
         self._solver_options = (
             replace(solver, method=settings.method) if settings.method != "hybrid" else None,
             replace(solver, method="newton", max_iterations=200),
             replace(solver, method="nsgs", max_iterations=settings.hybrid_sweeps),
-            replace(solver, method="nsgs"))
+            replace(solver, method="nsgs"),
+            replace(solver, method="newton", max_iterations=200, newton_direction="least_norm"))
         self._clusters(system)
         npair = system.pair_count
         k = MAX_CONTACTS_PER_PAIR
         self.previous_impulse = np.zeros((npair, k, 3))
         self.previous_bilateral = np.zeros(system.bilateral_row_count)
-        self._newton_first = False  # hybrid: the last problem needed Newton (see _solve)
+        self._newton_first = None  # hybrid: the Newton options that solved the last problem
         # the angle laws' continuous angles at the last step (forces.remember_angles)
         self.angle_memory = no_angle_memory(system.force_kind.shape[0])
         self.single_clusters = (np.arange(nb, dtype=np.int64),
@@ -500,13 +502,17 @@ class MoreauJeanStepper:
 
     # ------------------------------------------------------------------ pieces
     def _solve(self, problem: ContactProblem, r0: np.ndarray):
-        """One-step problem: NSGS, Newton, or ``hybrid``.
+        """One-step problem: NSGS, Newton (regularised, then least-norm if it did not
+        converge), or ``hybrid``.
 
         ``hybrid``: NSGS for at most ``hybrid_sweeps`` sweeps from the warm start; when it has
-        not converged, semismooth Newton from where NSGS stopped, then from the warm start, then
-        from zero, then NSGS to its full cap from zero and from where it stopped, keeping the
-        first that converges (else the smallest residual); after a step that needed Newton,
-        Newton from the warm start is tried first. Every attempt runs to its cap: stopping
+        not converged, semismooth Newton from where NSGS stopped, then Newton with the
+        least-norm direction from there (redundant bearing rings: it converges where the
+        regularised direction crawls, 7 of the 11 failed chains of c60-trip's first 6 ms), then
+        Newton from the warm start, then from zero, then NSGS to its full cap from zero and
+        from where it stopped, keeping the first that converges (else the smallest residual);
+        after a step that needed Newton, the Newton that converged is tried first from the
+        warm start. Every attempt runs to its cap: stopping
         the attempts early when their rate of progress could not reach the tolerance
         (``SolverOptions.stall_window``) was measured on c60-trip and dropped: 250 unconverged
         steps instead of 5, since a step whose NSGS is cut short goes through the whole chain.
@@ -514,34 +520,43 @@ class MoreauJeanStepper:
         Newton can stall from a poor start, while another start converges in a few iterations.
         """
         cfg = self.settings
-        single, newton, nsgs_first_options, nsgs = self._solver_options
+        single, newton, nsgs_first_options, nsgs, least_norm = self._solver_options
         if cfg.method != "hybrid":
-            return solve_contact_problem(problem, single, r0=r0)
+            result = solve_contact_problem(problem, single, r0=r0)
+            if result.converged or cfg.method != "newton":
+                return result
+            # Newton: the least-norm direction from the same start when the regularised one
+            # did not converge (redundant contacts), the better of the two kept.
+            again = solve_contact_problem(problem, least_norm, r0=r0)
+            best = again if again.converged or again.residual < result.residual else result
+            return replace(best, iterations=result.iterations + again.iterations)
         iterations = 0
-        if self._newton_first:
+        first = self._newton_first
+        if first is not None:
             # The last problem needed Newton: consecutive steps' problems are alike (the same
-            # redundant contacts), so Newton from the warm start first saves the NSGS sweeps
-            # that would stall again. Not converged: the usual chain follows.
-            best = solve_contact_problem(problem, newton, r0=r0)
+            # redundant contacts), so the Newton that converged then, from the warm start,
+            # first saves the NSGS sweeps that would stall again. Not converged: the usual
+            # chain follows.
+            best = solve_contact_problem(problem, first, r0=r0)
             if best.converged:
                 return best
             iterations = best.iterations
         nsgs_first = solve_contact_problem(problem, nsgs_first_options, r0=r0)
         iterations += nsgs_first.iterations
         if nsgs_first.converged:
-            self._newton_first = False
+            self._newton_first = None
             return replace(nsgs_first, iterations=iterations)
-        if not self._newton_first or nsgs_first.residual < best.residual:
+        if first is None or nsgs_first.residual < best.residual:
             best = nsgs_first
-        attempts = ((newton, nsgs_first.r), (newton, r0), (newton, None), (nsgs, None),
-                    (nsgs, nsgs_first.r))
+        attempts = ((newton, nsgs_first.r), (least_norm, nsgs_first.r), (newton, r0),
+                    (newton, None), (nsgs, None), (nsgs, nsgs_first.r))
         for options, start in attempts:
             attempt = solve_contact_problem(problem, options, r0=start)
             iterations += attempt.iterations
             if attempt.converged or attempt.residual < best.residual:
                 best = attempt
             if attempt.converged:
-                self._newton_first = options is newton
+                self._newton_first = options if options.method == "newton" else None
                 break
         return replace(best, iterations=iterations)
 

@@ -7,13 +7,15 @@ conditioning of what they solve.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
 from clearbench.adapters.base import RunSettings
 from clearbench.adapters.reference.build import build_system, initial_state
 from clearbench.adapters.reference.engine import create
-from clearbench.ref_solver import ContactProblem, SolverOptions
+from clearbench.ref_solver import ContactProblem, SolverOptions, natural_map_residual
 from clearbench.ref_solver.dense_kernels import lu_solve, roundoff_floor_dense
 from clearbench.ref_solver.fc3d_newton import solve_newton
 from clearbench.ref_solver.fc3d_residual import roundoff_floor
@@ -154,3 +156,19 @@ def test_compiled_projection_follows_the_numpy_projection(scene_name):
     # same arithmetic in another order: round-off, not amplified within 40 steps
     scale = max(np.abs(runs[False]).max(), 1e-3)
     np.testing.assert_allclose(runs[True], runs[False], rtol=0, atol=1e-12 * scale)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_least_norm_newton_solves_redundant_problems(seed):
+    # 36 rows of rank 12: the singular W of redundant bearing rings
+    problem = _problem(seed, rank=12)
+    options = dataclasses.replace(NEWTON, newton_direction="least_norm")
+    result = solve_newton(problem, options)
+    assert result.converged, result.message
+    assert natural_map_residual(problem.W, problem.q, problem.mu, result.r) == \
+        pytest.approx(result.residual, rel=1e-6, abs=1e-15)
+
+
+def test_newton_direction_is_validated():
+    with pytest.raises(ValueError, match="newton_direction"):
+        SolverOptions(method="newton", newton_direction="steepest")
