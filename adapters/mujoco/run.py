@@ -14,6 +14,7 @@ import numpy as np
 
 from clearbench.adapters.mujoco.settings import MujocoSettings
 from clearbench.adapters.trajectory import RunStatus, Trajectory
+from clearbench.kernels.time_profiles import evaluate_profile_slope
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.loads import LinearSpringDamper, Moment, PointForce, TorsionalSpringDamper
 from clearbench.scenarios.scene import Scene
@@ -31,47 +32,6 @@ logger = logging.getLogger(__name__)
 ENERGY_EXPECTATIONS = ("energy_non_increasing", "energy_conserved")
 #: Features that do work the energy bookkeeping does not count (the guard stays off).
 WORK_FEATURES = ("drivers", "point_forces", "moments", "angle_law_loads", "distance_law_loads")
-
-
-def profile_integral(times, values, t) -> np.ndarray:
-    """Exact integral from 0 to ``t`` (T,) of the piecewise-linear profile (constant outside
-    its breakpoints; jumps where two breakpoints coincide)."""
-    knots = np.asarray(times, dtype=float)
-    levels = np.asarray(values, dtype=float)
-    t = np.asarray(t, dtype=float)
-
-    def antiderivative(x):
-        x = np.asarray(x, dtype=float)
-        if len(knots) == 1:
-            return levels[0] * (x - knots[0])
-        widths = np.diff(knots)
-        cumulative = np.concatenate(([0.0], np.cumsum(0.5 * (levels[:-1] + levels[1:])
-                                                      * widths)))
-        index = np.clip(np.searchsorted(knots, x, side="right") - 1, 0, len(knots) - 2)
-        width = widths[index]
-        slope = np.where(width > 0, (levels[index + 1] - levels[index])
-                         / np.where(width > 0, width, 1.0), 0.0)
-        offset = x - knots[index]
-        inside = cumulative[index] + levels[index] * offset + 0.5 * slope * offset**2
-        before = levels[0] * (x - knots[0])
-        after = cumulative[-1] + levels[-1] * (x - knots[-1])
-        return np.where(x < knots[0], before, np.where(x >= knots[-1], after, inside))
-
-    return antiderivative(t) - antiderivative(0.0)
-
-
-def profile_slope(times, values, t) -> np.ndarray:
-    """Right derivative of the piecewise-linear profile at ``t`` (T,)."""
-    knots = np.asarray(times, dtype=float)
-    levels = np.asarray(values, dtype=float)
-    t = np.asarray(t, dtype=float)
-    if len(knots) == 1:
-        return np.zeros_like(t)
-    index = np.clip(np.searchsorted(knots, t, side="right") - 1, 0, len(knots) - 2)
-    width = knots[index + 1] - knots[index]
-    slope = np.where(width > 0, (levels[index + 1] - levels[index])
-                     / np.where(width > 0, width, 1.0), 0.0)
-    return np.where((t < knots[0]) | (t >= knots[-1]), 0.0, slope)
 
 
 class Runner:
@@ -130,14 +90,12 @@ class Runner:
         self._drive = []
         for dof in built.driven:
             driver = dof.driver
+            position = np.asarray(driver.displacement(step_times), dtype=float)
+            velocity = np.asarray(driver.velocity(step_times), dtype=float)
             if driver.quantity == "position":
-                position = np.asarray(driver.displacement(step_times), dtype=float)
-                velocity = np.asarray(driver.velocity(step_times), dtype=float)
                 acceleration = np.zeros_like(step_times)
             else:
-                position = profile_integral(driver.times, driver.values, step_times)
-                velocity = np.asarray(driver.velocity(step_times), dtype=float)
-                acceleration = profile_slope(driver.times, driver.values, step_times)
+                acceleration = evaluate_profile_slope(driver.times, driver.values, step_times)
             armature = model.dof_armature[dof.dof_address]
             self._drive.append((dof, dof.initial + dof.sign * position, dof.sign * velocity,
                                 armature * dof.sign * acceleration))
