@@ -21,11 +21,11 @@ from clearbench.adapters.mujoco.geometry import (
 )
 from clearbench.adapters.mujoco.run import Runner
 from clearbench.adapters.mujoco.settings import resolve_settings
-from clearbench.adapters.reference.build import build_system
 from clearbench.adapters.trajectory import RunStatus
 from clearbench.harness.measure import series as metrics
 from clearbench.kernels.quaternion import quat_from_axis_angle
 from clearbench.ref_solver.forces import element_forces, no_angle_memory
+from clearbench.ref_solver.scene_system import build_system
 from clearbench.scenarios.library import get_scene, scene_names
 from clearbench.scenarios.shapes import Bore
 

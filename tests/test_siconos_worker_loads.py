@@ -20,12 +20,12 @@ import numpy as np
 import pytest
 
 from clearbench.adapters.base import RunSettings, Support
-from clearbench.adapters.reference.build import build_system
 from clearbench.adapters.siconos import engine as siconos_engine
 from clearbench.adapters.trajectory import RunStatus
 from clearbench.kernels.quaternion import quat_normalize, quat_to_matrix
 from clearbench.kernels.time_profiles import evaluate_profile, evaluate_profile_slope
 from clearbench.ref_solver.forces import applied_forces, no_angle_memory, rotation_matrices
+from clearbench.ref_solver.scene_system import build_system
 from clearbench.scenarios.library import get_scene, scene_names
 from clearbench.scenarios.loads import AngleLawLoad, DistanceLawLoad, LoadApplication
 from clearbench.scenarios.scene import Scene

@@ -21,9 +21,7 @@ from clearbench.adapters.mujoco.geometry import (
     RingInfo,
     quat_multiply,
     quat_to_matrix,
-    scene_length_scale,
     shape_geoms,
-    smallest_feature_length,
 )
 from clearbench.adapters.mujoco.laws import LawForces, law_forces
 from clearbench.adapters.mujoco.settings import (
@@ -42,6 +40,7 @@ from clearbench.scenarios.loads import (
     PointForce,
     TorsionalSpringDamper,
 )
+from clearbench.scenarios.scales import largest_length, smallest_feature_length
 from clearbench.scenarios.scene import Scene
 
 INTEGRATORS = {"Euler": mujoco.mjtIntegrator.mjINT_EULER,
@@ -124,7 +123,7 @@ def build_model(scene: Scene, settings: MujocoSettings, time_step: float) -> Bui
         reasons = "; ".join(f"{feature}: {why}" for feature, why in topology.problems)
         raise ValueError(f"scene {scene.name!r} cannot be built in MuJoCo: {reasons}")
     poses = _world_poses(scene)
-    length_scale = scene_length_scale(scene)
+    length_scale = largest_length(scene)
     spec = mujoco.MjSpec()
     spec.modelname = scene.name
     spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_FALSE

@@ -127,39 +127,6 @@ def matrix_to_quat(matrix) -> np.ndarray:
     return q if q[0] >= 0 else -q
 
 
-def scene_length_scale(scene: Scene) -> float:
-    """Largest characteristic length of the scene (shape sizes, body positions) [L]."""
-    lengths = [1e-300]
-    for body in scene.expanded.bodies:
-        lengths.append(float(np.linalg.norm(body.position)))
-        lengths.append(float(np.linalg.norm(body.center_of_mass)))
-        for shape in body.shapes:
-            lengths.append(float(np.linalg.norm(shape.position)))
-            for name in ("radius", "half_length"):
-                lengths.append(float(getattr(shape, name, 0.0)))
-            lengths += [float(x) for x in getattr(shape, "half_extents", ())]
-    return max(lengths)
-
-
-def smallest_feature_length(scene: Scene) -> float:
-    """Smallest positive clearance, offset or shape dimension [L] (the scale collision
-    tolerances must resolve)."""
-    lengths = []
-    for joint in scene.clearance_joints:
-        lengths += [joint.radial_clearance, joint.axial_clearance]
-    for contact in scene.all_contacts:
-        if contact.offset != 0:
-            lengths.append(abs(contact.offset))
-    for body in scene.expanded.bodies:
-        for shape in body.shapes:
-            for name in ("radius", "half_length"):
-                if hasattr(shape, name):
-                    lengths.append(getattr(shape, name))
-            lengths += list(getattr(shape, "half_extents", ()))
-    positive = [x for x in lengths if x > 0 and math.isfinite(x)]
-    return min(positive) if positive else scene_length_scale(scene)
-
-
 def ring_piece_radius(scene: Scene, body: str, shape: Shape, settings: MujocoSettings) -> float:
     """Piece radius of a ring: ``ring_piece_radius`` times its radius, at most half the radial
     clearance of the clearance joint it belongs to."""

@@ -17,6 +17,7 @@ from clearbench.adapters.trajectory import RunStatus, Trajectory
 from clearbench.kernels.time_profiles import evaluate_profile_slope
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.loads import LinearSpringDamper, Moment, PointForce, TorsionalSpringDamper
+from clearbench.scenarios.scales import largest_shape_dimension
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.validation import (
     ANGULAR_VELOCITY,
@@ -118,14 +119,9 @@ class Runner:
         return True
 
     def _size_energy_scale(self) -> float:
-        size = 0.0
-        for body in self.scene.expanded.bodies:
-            for shape in body.shapes:
-                values = [getattr(shape, "radius", 0.0), getattr(shape, "half_length", 0.0)]
-                values += list(getattr(shape, "half_extents", ()))
-                size = max(size, *values)
+        """sum(m |g|) over the moving bodies x the largest shape dimension [M L^2/T^2]."""
         g = float(np.linalg.norm(self.gravity))
-        return float(np.sum(self.mass[self.movable])) * g * size
+        return float(np.sum(self.mass[self.movable])) * g * largest_shape_dimension(self.scene)
 
     def _check_warnings(self) -> str | None:
         counts = self.data.warning.number

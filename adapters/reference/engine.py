@@ -28,11 +28,12 @@ import time
 import numpy as np
 
 from clearbench.adapters.base import Capability, Engine, RunSettings, Support
-from clearbench.adapters.reference.build import build_system, feature_lengths, initial_state
 from clearbench.adapters.trajectory import RunStatus, Trajectory
 from clearbench.kernels.quaternion import quat_rotate_batch
 from clearbench.ref_solver.contact_problem import SolverOptions
+from clearbench.ref_solver.scene_system import build_system, initial_state
 from clearbench.ref_solver.stepper import MoreauJeanStepper, StepperSettings
+from clearbench.scenarios.scales import feature_lengths
 from clearbench.scenarios.scene import Scene
 
 PRESETS: dict[str, dict] = {

@@ -49,7 +49,6 @@ from pathlib import Path
 import numpy as np
 
 from clearbench.adapters.base import Capability, Engine, RunSettings, Support
-from clearbench.adapters.reference.build import feature_lengths
 from clearbench.adapters.siconos.process import (
     SICONOS_PYTHON,
     WorkerStatus,
@@ -59,6 +58,7 @@ from clearbench.adapters.siconos.process import (
 from clearbench.adapters.siconos.worker import geometry as worker_geometry
 from clearbench.adapters.trajectory import RunStatus, Trajectory
 from clearbench.kernels.quaternion import quat_normalize, quat_to_matrix
+from clearbench.scenarios.scales import feature_lengths
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.serialization import scene_to_json
 

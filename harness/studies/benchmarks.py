@@ -18,12 +18,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from clearbench.adapters.base import RunSettings
-from clearbench.adapters.reference.build import feature_lengths
 from clearbench.adapters.reference.engine import create
 from clearbench.harness.measure import series as metrics
 from clearbench.kernels.quaternion import quat_angular_distance_batch
 from clearbench.scenarios import analytic
 from clearbench.scenarios.library import get_scene
+from clearbench.scenarios.scales import feature_lengths
 
 
 @dataclass(frozen=True)

@@ -1,16 +1,17 @@
-"""Scene -> :class:`~clearbench.ref_solver.system.MultibodySystem` for the reference engine.
+"""Scene -> :class:`~clearbench.ref_solver.system.MultibodySystem` and initial
+:class:`~clearbench.ref_solver.system.State`: the array form the solver steps.
 
 Clearance joints are expanded into their shapes and contact pairs (Scene.expanded); bodies are
 described at their centre of mass with the scene's body axes; everything stays in the scene's
-units.
+units. The reference engine builds its runs with it, and the MuJoCo adapter packs its law loads
+with it (one evaluation of the laws, :mod:`clearbench.ref_solver.forces`).
 """
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
+from clearbench.kernels.poses import centre_of_mass_frames
 from clearbench.kernels.quaternion import (
     quat_conjugate,
     quat_multiply,
@@ -50,15 +51,15 @@ def _unit(quaternion) -> np.ndarray:
 
 
 def body_frames(scene: Scene) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Centre-of-mass positions (nb, 3), quaternions (nb, 4), rotations (nb, 3, 3) at t = 0."""
-    p = np.array([_unit(b.orientation) for b in scene.bodies])
-    rotation = np.array([quat_to_matrix(q) for q in p])
-    x = np.array([np.asarray(b.position) + rotation[i] @ np.asarray(b.center_of_mass)
-                  for i, b in enumerate(scene.bodies)])
-    return x, p, rotation
+    """Centre-of-mass positions (nb, 3) [L], unit quaternions (nb, 4) and rotations
+    (nb, 3, 3) of the scene's bodies at t = 0."""
+    return centre_of_mass_frames([b.position for b in scene.bodies],
+                                 [b.orientation for b in scene.bodies],
+                                 [b.center_of_mass for b in scene.bodies])
 
 
 def initial_state(scene: Scene) -> State:
+    """State at t = 0: centres of mass, orientations, twists (fixed bodies at rest)."""
     x, p, _ = body_frames(scene)
     v = np.array([b.velocity for b in scene.bodies], dtype=float)
     omega = np.array([b.angular_velocity for b in scene.bodies], dtype=float)
@@ -246,28 +247,3 @@ def build_system(scene: Scene) -> MultibodySystem:
         pair_names=tuple(c.name for c in contacts),
         joint_names=tuple(j.name for j in scene.joints),
     )
-
-
-def feature_lengths(scene: Scene) -> list[float]:
-    """Characteristic lengths of the scene: clearances, offsets, shape dimensions [L]."""
-    lengths = []
-    for joint in scene.clearance_joints:
-        lengths += [joint.radial_clearance, joint.axial_clearance]
-    for body in scene.expanded.bodies:
-        for shape in body.shapes:
-            for name in ("radius", "half_length"):
-                if hasattr(shape, name):
-                    lengths.append(getattr(shape, name))
-            if hasattr(shape, "half_extents"):
-                lengths += list(shape.half_extents)
-    for contact in scene.all_contacts:
-        if contact.offset > 0:
-            lengths.append(contact.offset)
-    # Joint lever arms: distance from each body's centre of mass to its joint anchors.
-    x, _, _ = body_frames(scene)
-    for joint in scene.joints:
-        for name in (joint.body_a, joint.body_b):
-            if scene.body(name).motion is not Motion.FIXED:
-                lengths.append(float(np.linalg.norm(np.asarray(joint.anchor)
-                                                    - x[scene.body_index(name)])))
-    return [length for length in lengths if length > 0 and math.isfinite(length)]
