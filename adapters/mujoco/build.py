@@ -19,8 +19,6 @@ from clearbench.adapters.mujoco.geometry import (
     GeomSpec,
     PairSpec,
     RingInfo,
-    quat_multiply,
-    quat_to_matrix,
     shape_geoms,
 )
 from clearbench.adapters.mujoco.laws import LawForces, law_forces
@@ -31,6 +29,12 @@ from clearbench.adapters.mujoco.settings import (
     time_step_warnings,
 )
 from clearbench.adapters.mujoco.topology import Topology, plan_topology
+from clearbench.kernels.quaternion import (
+    quat_conjugate,
+    quat_multiply,
+    quat_normalize,
+    quat_to_matrix,
+)
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.loads import (
     AngleLawLoad,
@@ -103,15 +107,14 @@ def _relative_pose(parent_pose, child_pose) -> tuple[np.ndarray, np.ndarray]:
     """Pose of the child frame in the parent frame."""
     (xp, qp), (xc, qc) = parent_pose, child_pose
     rotation = quat_to_matrix(qp)
-    conjugate = np.array([qp[0], -qp[1], -qp[2], -qp[3]])
-    return rotation.T @ (xc - xp), quat_multiply(conjugate, qc)
+    return rotation.T @ (xc - xp), quat_multiply(quat_conjugate(qp), qc)
 
 
 def _world_poses(scene: Scene) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     out = {}
     for body in scene.bodies:
-        q = np.asarray(body.orientation, dtype=float)
-        out[body.name] = (np.asarray(body.position, dtype=float), q / np.linalg.norm(q))
+        out[body.name] = (np.asarray(body.position, dtype=float),
+                          quat_normalize(np.asarray(body.orientation, dtype=float)))
     return out
 
 

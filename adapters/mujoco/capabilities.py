@@ -23,7 +23,7 @@ from clearbench.adapters.mujoco.settings import (
     ring_clearance_error,
 )
 from clearbench.adapters.mujoco.topology import plan_topology
-from clearbench.kernels.quaternion import quat_multiply, quat_to_matrix
+from clearbench.kernels.quaternion import quat_multiply, quat_normalize, quat_to_matrix
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.shapes import Arc, Bore, Circle, Cylinder, Disc, Plane, Rectangle
@@ -101,7 +101,7 @@ def _axis_world(scene: Scene, body_name: str, shape) -> np.ndarray:
     body = scene.expanded.body(body_name)
     q = quat_multiply(np.asarray(body.orientation, dtype=float),
                       np.asarray(shape.orientation, dtype=float))
-    return quat_to_matrix(q / np.linalg.norm(q))[:, 2]
+    return quat_to_matrix(quat_normalize(q))[:, 2]
 
 
 def journal_clearances(scene: Scene, body_name: str, shape) -> list[tuple[str, float | None]]:
