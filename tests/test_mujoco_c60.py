@@ -169,7 +169,7 @@ def test_the_run_loop_applies_the_law_loads_and_the_moment_every_step():
     scene = get_scene("c60-on")
     settings = resolve_settings("tuned")
     built = _perturbed_model(scene)
-    runner = Runner(_internal_scene(scene, settings), built, settings, steps=1, samples=2)
+    runner = Runner(_internal_scene(scene, settings), built, settings, steps=1, record_every=1)
     mujoco.mj_step1(built.model, built.data)
     runner.apply_loads()
     expected = built.law_forces.wrenches(built.data)

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
+from clearbench.adapters.mujoco.engine import create
 from clearbench.adapters.mujoco.settings import (
     PRESETS,
     contact_parameters,
@@ -118,9 +119,9 @@ def test_presets_and_options():
     # An explicit solref replaces the step-relative timeconst of the preset.
     assert resolve_settings("tuned", {"solref": (0.005, 0.07)}).contact_timeconst(1e-3) == 0.005
     with pytest.raises(ValueError, match="unknown mujoco options"):
-        resolve_settings("tuned", {"solref_typo": 1})
+        create("tuned").settings({"solref_typo": 1})
     with pytest.raises(ValueError, match="unknown mujoco preset"):
-        resolve_settings("fast")
+        create("fast")
     with pytest.raises(ValueError, match="cone"):
         resolve_settings("default", {"cone": "round"})
 

@@ -1,6 +1,6 @@
 """Scene -> compiled MuJoCo model (MjSpec), with the maps the run loop needs.
 
-The scene is expected in the model's internal units (see :mod:`.mujoco_engine`). Clearance
+The scene is expected in the model's internal units (see :mod:`.engine`). Clearance
 joints are expanded into their shapes and contact pairs (Scene.expanded). Every MuJoCo body
 frame is the scene's body frame; its inertial frame (centre of mass, principal axes) is set
 from the scene's centre of mass and inertia tensor, and MuJoCo diagonalises it. Geoms have
@@ -319,7 +319,7 @@ def _add_loads(spec, scene: Scene, topology: Topology, poses, spec_bodies, warni
                time_step: float):
     """Springs as tendons / joint stiffness, preloads as motor actuators; point forces,
     moments and other torsional springs as Python loads applied every step (law loads are
-    left to :func:`.mujoco_laws.law_forces`)."""
+    left to :func:`.laws.law_forces`)."""
     python_loads: list[PythonLoad] = []
     controls: list[tuple[str, float]] = []
     hinge_springs: list[tuple] = []
@@ -368,7 +368,7 @@ def _add_loads(spec, scene: Scene, topology: Topology, poses, spec_bodies, warni
         elif isinstance(load, PointForce | Moment):
             python_loads.append(PythonLoad(load, -1))
         elif isinstance(load, AngleLawLoad | DistanceLawLoad):
-            continue  # evaluated by the reference's force function (mujoco_laws)
+            continue  # evaluated by the reference's force function (laws.py)
         else:  # pragma: no cover - every load kind is handled above
             raise TypeError(f"unhandled load kind {load.kind!r}")
     return python_loads, controls, hinge_springs

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from clearbench.adapters import ENGINES
 from clearbench.adapters.base import RunSettings
 from clearbench.adapters.reference.engine import create
 from clearbench.harness.measure import series as metrics
@@ -312,11 +313,10 @@ def engine_physics_table(engine_name: str = "reference", preset: str = "default"
     and preset, at each of ``time_steps`` (None: the scene's own step) [scene units]."""
     import importlib
 
-    from clearbench.adapters.registry import ENGINE_MODULES
     from clearbench.harness.measure.expectation_figures import evaluate
     from clearbench.scenarios.library import scene_names
 
-    module = importlib.import_module(f"clearbench.adapters.{ENGINE_MODULES[engine_name]}")
+    module = importlib.import_module(ENGINES[engine_name])
     engine = module.create(preset)
     rows = []
     for name in scene_names(tag):
