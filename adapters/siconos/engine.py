@@ -52,7 +52,7 @@ from clearbench.adapters.base import Capability, Engine, RunSettings, Support
 from clearbench.adapters.siconos.process import (
     SICONOS_PYTHON,
     WorkerStatus,
-    clean_environment,
+    interpreter_imports,
     run_worker,
 )
 from clearbench.adapters.siconos.worker import geometry as worker_geometry
@@ -146,19 +146,10 @@ def _pair_capability(kind_a: str, kind_b: str, projection: bool = False) -> Capa
 @functools.cache
 def availability() -> tuple[bool, str]:
     """Whether Debian's interpreter imports the Siconos kernel and joints (never raises)."""
-    if not Path(SICONOS_PYTHON).exists():
-        return False, f"Siconos unavailable: {SICONOS_PYTHON} not found"
-    try:
-        completed = subprocess.run(
-            [SICONOS_PYTHON, "-c",
-             "import siconos.kernel, siconos.mechanics.joints, siconos.numerics"],
-            env=clean_environment(), capture_output=True, text=True, timeout=120)
-    except (OSError, subprocess.TimeoutExpired) as error:
-        return False, f"Siconos unavailable: {error}"
-    if completed.returncode != 0:
-        last = (completed.stderr.strip().splitlines() or ["import failed"])[-1]
-        return False, (f"Siconos unavailable ({last}); install Debian's python3-siconos "
-                       "(`make siconos` as root)")
+    available, why = interpreter_imports(
+        "siconos.kernel, siconos.mechanics.joints, siconos.numerics")
+    if not available:
+        return False, why
     try:
         version = subprocess.run(
             ["dpkg-query", "-W", "-f=${Version}", "python3-siconos"],

@@ -589,6 +589,7 @@ class SiconosModel:
     """The Siconos model of a scene and its stepping; every Siconos object stays referenced."""
 
     def __init__(self, scene, settings):
+        # Lazy imports of the engine package: the tests import this module without Siconos.
         import siconos.kernel as sk
         import siconos.mechanics.joints as joints
         import siconos.numerics as sn
