@@ -19,6 +19,12 @@ from clearbench.scenarios.bodies import Body, Motion
 from clearbench.scenarios.contacts import ContactPair
 from clearbench.scenarios.drivers import Driver
 from clearbench.scenarios.expectations import Expectation
+from clearbench.scenarios.features import (
+    LOAD_FEATURES,
+    joint_feature,
+    pair_feature,
+    shape_feature,
+)
 from clearbench.scenarios.joints import ClearanceRevoluteJoint, Joint
 from clearbench.scenarios.loads import Load, Moment, PointForce
 from clearbench.scenarios.outputs import ContactForce, Output
@@ -230,7 +236,8 @@ class Scene:
     # ------------------------------------------------------------------ derived
     @cached_property
     def features(self) -> frozenset[str]:
-        """Features the scene uses, derived from its content.
+        """Features the scene uses, derived from its content (written and read with
+        :mod:`clearbench.scenarios.features`).
 
         Vocabulary: ``gravity``, ``contacts``, ``friction``, ``restitution``, ``shape:<kind>``,
         ``pair:<kind>-<kind>`` (sorted), ``ideal_joints``, ``joint:<kind>``, ``closed_loop``,
@@ -251,30 +258,24 @@ class Scene:
                 features.add("friction")
             if contact.restitution > 0:
                 features.add("restitution")
-            kinds = sorted(
-                (shapes[(contact.body_a, contact.shape_a)].kind,
-                 shapes[(contact.body_b, contact.shape_b)].kind)
-            )
-            features.add(f"pair:{kinds[0]}-{kinds[1]}")
+            kinds = (shapes[(contact.body_a, contact.shape_a)].kind,
+                     shapes[(contact.body_b, contact.shape_b)].kind)
+            features.add(pair_feature(*kinds))
             for kind in kinds:
-                features.add(f"shape:{kind}")
+                features.add(shape_feature(kind))
                 if kind == "circle":
                     features.add("rings")
                 if kind == "arc":
                     features.add("arcs")
         if self.joints:
             features.add("ideal_joints")
-            features.update(f"joint:{joint.kind}" for joint in self.joints)
+            features.update(joint_feature(joint.kind) for joint in self.joints)
             if self._joint_graph_has_cycle():
                 features.add("closed_loop")
         if self.clearance_joints:
             features.add("clearance_joints")
         for load in self.loads:
-            features.add({
-                "linear_spring": "springs", "torsional_spring": "torsional_springs",
-                "point_force": "point_forces", "moment": "moments",
-                "angle_law": "angle_law_loads", "distance_law": "distance_law_loads",
-            }[load.kind])
+            features.add(LOAD_FEATURES[load.kind])
             if isinstance(load, PointForce | Moment) and (
                 load.start_time > 0 or load.end_time is not None
             ):

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from clearbench.adapters.mujoco.run import profile_integral, profile_slope
+from clearbench.adapters.mujoco.engine import create
 from clearbench.adapters.mujoco.settings import (
     PRESETS,
     contact_parameters,
@@ -21,7 +21,6 @@ from clearbench.adapters.mujoco.settings import (
     ring_clearance_error,
     time_step_warnings,
 )
-from clearbench.scenarios.drivers import Driver
 
 
 def _restitution_by_ode(zeta: float) -> float:
@@ -120,9 +119,9 @@ def test_presets_and_options():
     # An explicit solref replaces the step-relative timeconst of the preset.
     assert resolve_settings("tuned", {"solref": (0.005, 0.07)}).contact_timeconst(1e-3) == 0.005
     with pytest.raises(ValueError, match="unknown mujoco options"):
-        resolve_settings("tuned", {"solref_typo": 1})
+        create("tuned").settings({"solref_typo": 1})
     with pytest.raises(ValueError, match="unknown mujoco preset"):
-        resolve_settings("fast")
+        create("fast")
     with pytest.raises(ValueError, match="cone"):
         resolve_settings("default", {"cone": "round"})
 
@@ -139,23 +138,3 @@ def test_ring_errors():
     for piece in ("sphere", "capsule"):
         extra = ring_clearance_error(2.1e-3, 21e-6, 64, piece)
         assert 0 < extra == pytest.approx(21e-6 * (math.pi / 64) ** 2 / 2, rel=0.05)
-
-
-@pytest.mark.parametrize("times, values", [
-    ((0.0,), (2.0,)),
-    ((0.0, 0.7, 0.7, 2.0), (0.0, 0.0, 0.2, 0.2)),      # switched on at 0.7 (the C-60 plunger)
-    ((0.1, 0.5, 0.9, 0.9, 1.5), (1.0, -2.0, 3.0, 0.5, 0.0)),
-])
-def test_driver_profile_integral_and_slope(times, values):
-    driver = Driver("d", body="b", component="x", quantity="velocity", times=times,
-                    values=values)
-    t = np.linspace(0.0, 2.5, 251)
-    exact = np.array([driver.displacement(float(x)) for x in t])
-    # Both exact for piecewise-linear profiles: only round-off differs.
-    assert np.allclose(profile_integral(times, values, t), exact, rtol=1e-12, atol=1e-12)
-    slope = profile_slope(times, values, t)
-    h = 1e-7
-    numeric = (np.asarray(driver.velocity(t + h)) - np.asarray(driver.velocity(t))) / h
-    away_from_knots = np.min(np.abs(t[:, None] - np.asarray(times)[None, :]), axis=1) > 1e-3
-    # Forward difference of a linear segment: exact up to round-off (1e-7 step, O(1) values).
-    assert np.allclose(slope[away_from_knots], numeric[away_from_knots], atol=1e-6)

@@ -13,9 +13,9 @@ import math
 import numpy as np
 import pytest
 
+from clearbench.adapters import engine_availability
 from clearbench.adapters.base import RunSettings, Support
 from clearbench.adapters.reference.engine import create as create_reference
-from clearbench.adapters.registry import engine_availability
 from clearbench.adapters.siconos import engine as siconos_engine
 from clearbench.adapters.siconos import process as siconos_process
 from clearbench.adapters.trajectory import RunStatus, Trajectory

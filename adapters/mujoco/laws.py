@@ -1,8 +1,8 @@
 """Law loads (angle and distance laws) in MuJoCo: evaluated by the reference solver's own force
 function from the MuJoCo state at the start of every step and applied through ``xfrc_applied``.
 
-One implementation of the laws: the scene's law loads are packed into force elements by the
-reference engine's :func:`~clearbench.adapters.reference.build.build_system` and evaluated by
+One implementation of the laws: the scene's law loads are packed into force elements by
+:func:`clearbench.ref_solver.scene_system.build_system` and evaluated by
 :func:`clearbench.ref_solver.forces.element_forces`, exactly as the reference engine does. The
 force acts at the start-of-step configuration during the whole step (explicit, one step lag).
 Law loads depend on the configuration only (angles, a distance), not on velocities.
@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from clearbench.ref_solver.forces import element_forces, no_angle_memory, remember_angles
+from clearbench.ref_solver.scene_system import build_system
 from clearbench.ref_solver.system import FORCE_ANGLE_LAW, FORCE_DISTANCE_LAW
 from clearbench.scenarios.loads import AngleLawLoad, DistanceLawLoad
 from clearbench.scenarios.scene import Scene
@@ -111,8 +112,6 @@ def law_forces(scene: Scene, model) -> LawForces | None:
     if problems:
         raise ValueError("law loads MuJoCo cannot apply: "
                          + "; ".join(reason for _, reason in problems))
-    from clearbench.adapters.reference.build import build_system
-
     system = build_system(scene)
     keep = np.isin(system.force_kind, LAW_KINDS)
     body_ids = np.array([model.body(name).id for name in system.body_names], dtype=np.int64)

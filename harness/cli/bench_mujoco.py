@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import sys
 
-from clearbench.adapters.registry import engine_availability
+from clearbench.adapters import engine_availability
 from clearbench.harness.cli.main import UserError
 from clearbench.harness.studies.physics_table import (
     DEFAULT_SCENES,

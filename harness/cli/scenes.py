@@ -6,7 +6,7 @@ import argparse
 import sys
 import textwrap
 
-from clearbench.adapters.registry import all_availability
+from clearbench.adapters import all_availability
 from clearbench.harness.cli.main import UserError
 from clearbench.scenarios.library import SCENES, get_entry, scene_names
 from clearbench.scenarios.serialization import (

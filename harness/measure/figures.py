@@ -46,6 +46,7 @@ import numpy as np
 
 from clearbench.adapters.trajectory import RunStatus, Trajectory
 from clearbench.scenarios.bodies import Motion
+from clearbench.scenarios.scales import contact_feature_sizes, scene_size
 from clearbench.scenarios.scene import Scene
 
 LOG = logging.getLogger(__name__)
@@ -96,29 +97,6 @@ def first_non_finite(trajectory: Trajectory) -> str | None:
     if len(trajectory.times) and not np.isfinite(trajectory.times).all():
         return "non-finite sample times"
     return None
-
-
-def shape_size(shape) -> float:
-    """Smallest characteristic size of a shape [L] (inf for a half-space)."""
-    if hasattr(shape, "half_extents"):
-        return float(min(shape.half_extents))
-    if hasattr(shape, "radius"):
-        return float(shape.radius)
-    return math.inf
-
-
-def _body_size(body) -> float:
-    from clearbench.harness.measure import series as metrics
-
-    return metrics.body_size(body)
-
-
-def scene_size(scene: Scene) -> float:
-    """Length scale of the scene's initial configuration [L] (> 0)."""
-    positions = np.array([b.position for b in scene.bodies], dtype=float)
-    spread = float(np.max(np.ptp(positions, axis=0))) if len(positions) > 1 else 0.0
-    size = max([spread] + [_body_size(b) for b in scene.bodies])
-    return size if size > 0 else 1.0
 
 
 def _expectation_results(scene: Scene, trajectory: Trajectory, out: _Collector):
@@ -239,9 +217,7 @@ def _drift(scene, trajectory, metrics, out: _Collector, reasons: list[str]) -> N
     if contacts:
         depth = metrics.penetration(scene, trajectory)
         out.put("penetration_max", np.max(depth))
-        shapes = {(b.name, s.name): s for b in scene.expanded.bodies for s in b.shapes}
-        feature = np.array([min(shape_size(shapes[(c.body_a, c.shape_a)]),
-                                shape_size(shapes[(c.body_b, c.shape_b)])) for c in contacts])
+        feature = contact_feature_sizes(scene)
         relative = np.max(depth, axis=0) / feature
         out.put("penetration_relative", np.max(relative))
         worst = int(np.argmax(relative))

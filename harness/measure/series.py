@@ -24,6 +24,7 @@ from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.geometry import contacts_between
 from clearbench.scenarios.loads import LinearSpringDamper, TorsionalSpringDamper
 from clearbench.scenarios.outputs import BodyAngle, ContactForce, PointDistance, PointPosition
+from clearbench.scenarios.scales import body_size
 from clearbench.scenarios.scene import Scene
 
 
@@ -292,17 +293,6 @@ def output_values(scene: Scene, trajectory: Trajectory) -> dict[str, np.ndarray]
 def rotation_matrices(trajectory: Trajectory) -> np.ndarray:
     """(T, nb, 3, 3) body-to-world rotations."""
     return quat_to_matrix_batch(quat_normalize_batch(trajectory.orientations))
-
-
-def body_size(body) -> float:
-    """Size of a body [L]: its largest shape extent, or its centre-of-mass offset."""
-    sizes = []
-    for shape in body.shapes:
-        if hasattr(shape, "half_extents"):
-            sizes.append(float(np.linalg.norm(shape.half_extents)))
-        elif hasattr(shape, "radius"):
-            sizes.append(float(shape.radius) + float(getattr(shape, "half_length", 0.0)))
-    return max(sizes + [float(np.linalg.norm(body.center_of_mass))])
 
 
 def energy_scale(scene: Scene, energy: Energy) -> float:

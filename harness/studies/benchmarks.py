@@ -17,13 +17,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from clearbench.adapters import ENGINES
 from clearbench.adapters.base import RunSettings
-from clearbench.adapters.reference.build import feature_lengths
 from clearbench.adapters.reference.engine import create
 from clearbench.harness.measure import series as metrics
 from clearbench.kernels.quaternion import quat_angular_distance_batch
 from clearbench.scenarios import analytic
 from clearbench.scenarios.library import get_scene
+from clearbench.scenarios.scales import feature_lengths
 
 
 @dataclass(frozen=True)
@@ -312,11 +313,10 @@ def engine_physics_table(engine_name: str = "reference", preset: str = "default"
     and preset, at each of ``time_steps`` (None: the scene's own step) [scene units]."""
     import importlib
 
-    from clearbench.adapters.registry import ENGINE_MODULES
     from clearbench.harness.measure.expectation_figures import evaluate
     from clearbench.scenarios.library import scene_names
 
-    module = importlib.import_module(f"clearbench.adapters.{ENGINE_MODULES[engine_name]}")
+    module = importlib.import_module(ENGINES[engine_name])
     engine = module.create(preset)
     rows = []
     for name in scene_names(tag):
