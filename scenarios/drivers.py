@@ -4,8 +4,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from clearbench.scenarios.element import Element
-from clearbench.scenarios.time_profiles import check_profile, evaluate_profile
+from clearbench.scenarios.time_profiles import check_profile, evaluate_profile, integrate_profile
 from clearbench.scenarios.validation import (
     ANGULAR_VELOCITY,
     DIMENSIONLESS,
@@ -72,8 +74,6 @@ class Driver(Element):
         """Prescribed rate of the component at time(s) ``t`` [L/T or rad/T]."""
         if self.quantity == "velocity":
             return evaluate_profile(self.times, self.values, t)
-        import numpy as np
-
         # Position profiles are piecewise linear: the rate is the slope of the current segment.
         times = np.asarray(self.times)
         values = np.asarray(self.values)
@@ -89,10 +89,6 @@ class Driver(Element):
         """Prescribed displacement of the component from t = 0 [L or rad]."""
         if self.quantity == "position":
             return evaluate_profile(self.times, self.values, t)
-        import numpy as np
-
-        from clearbench.scenarios.time_profiles import integrate_profile
-
         if np.ndim(t) == 0:
             return integrate_profile(self.times, self.values, 0.0, float(t))
         return np.array([integrate_profile(self.times, self.values, 0.0, float(x)) for x in t])
