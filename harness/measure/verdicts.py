@@ -1,4 +1,6 @@
-"""Pass/fail of each expectation in the harness's results and report, and the analytic error.
+"""Pass/fail criteria: of each expectation in the harness's results and report, and which
+expectation figure is a run's analytic error. (The run's own verdict, ok or diverged, is
+:func:`clearbench.harness.measure.figures.measure`'s.)
 
 :func:`clearbench.harness.measure.expectation_figures.evaluate` states figures, not verdicts:
 what is acceptable depends on the use. These are the harness's criteria (shown in the report), each
@@ -31,9 +33,10 @@ from __future__ import annotations
 
 import math
 
+from clearbench.harness.measure.series import body_size, shape_size
 from clearbench.scenarios.scene import Scene
 
-#: kind -> figure of :mod:`.expectations` that is the run's relative error against the
+#: kind -> figure of :mod:`.expectation_figures` that is the run's relative error against the
 #: analytic solution (first one present is used), and the figure that normalises it if any.
 ANALYTIC_ERROR: dict[str, tuple[tuple[str, str | None], ...]] = {
     "bounce_apex": (("apex_max_relative_error", None),),
@@ -64,8 +67,6 @@ def analytic_error(kind: str, figures: dict) -> float:
 
 
 def _smallest_contact_feature(scene: Scene) -> float:
-    from clearbench.harness.measure.figures import shape_size
-
     expanded = scene.expanded
     shapes = {(b.name, s.name): s for b in expanded.bodies for s in b.shapes}
     sizes = [min(shape_size(shapes[(c.body_a, c.shape_a)]),
@@ -76,9 +77,7 @@ def _smallest_contact_feature(scene: Scene) -> float:
 
 
 def _body_size(scene: Scene, body: str) -> float:
-    from clearbench.harness.measure.figures import _body_size as size
-
-    return size(scene.body(body))
+    return body_size(scene.body(body))
 
 
 def _within(value, bound) -> bool | None:
