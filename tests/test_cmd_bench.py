@@ -1,13 +1,16 @@
-"""``clearbench mujoco-table`` in-process: prints the shared evaluator's figures; bad input
-exits with status 2."""
+"""``clearbench bench`` in-process: the list of benchmarks; ``bench mujoco-table`` prints the
+shared evaluator's figures; bad input exits with status 2."""
 
 from __future__ import annotations
 
+import pytest
+
+from clearbench.harness.cli.bench import BENCHMARKS
 from clearbench.harness.cli.main import main
 
 
 def test_mujoco_table_prints_the_expectation_figures(capsys):
-    status = main(["mujoco-table", "--scene", "pendulum", "--scene", "incline-stick",
+    status = main(["bench", "mujoco-table", "--scene", "pendulum", "--scene", "incline-stick",
                    "--preset", "tuned", "--dt", "1e-3", "--horizon", "0.2"])
     assert status == 0
     out = capsys.readouterr().out
@@ -17,16 +20,33 @@ def test_mujoco_table_prints_the_expectation_figures(capsys):
 
 
 def test_mujoco_table_compact_is_one_table(capsys):
-    assert main(["mujoco-table", "--scene", "pendulum", "--preset", "default", "--dt", "1e-3",
-                 "--horizon", "0.1", "--compact"]) == 0
+    assert main(["bench", "mujoco-table", "--scene", "pendulum", "--preset", "default",
+                 "--dt", "1e-3", "--horizon", "0.1", "--compact"]) == 0
     out = capsys.readouterr().out
     assert out.startswith("| scene | figure | mujoco[default] dt=0.001 |")
     assert "| pendulum | period, relative error [%] |" in out
 
 
 def test_mujoco_table_rejects_bad_input(capsys):
-    assert main(["mujoco-table", "--preset", "fast"]) == 2
+    assert main(["bench", "mujoco-table", "--preset", "fast"]) == 2
     assert "unknown preset" in capsys.readouterr().err
-    assert main(["mujoco-table", "--scene", "nope"]) == 2
-    assert main(["mujoco-table", "--dt", "-1"]) == 2
-    assert main(["mujoco-table", "--no-mujoco"]) == 2
+    assert main(["bench", "mujoco-table", "--scene", "nope"]) == 2
+    assert main(["bench", "mujoco-table", "--dt", "-1"]) == 2
+    assert main(["bench", "mujoco-table", "--no-mujoco"]) == 2
+
+
+def test_bench_lists_every_benchmark_without_a_name_or_with_list(capsys):
+    assert main(["bench"]) == 0
+    listed = capsys.readouterr().out
+    assert main(["bench", "--list", "reference"]) == 0  # --list wins over a name
+    assert capsys.readouterr().out == listed
+    names = [line.split()[0] for line in listed.splitlines()]
+    assert names == list(BENCHMARKS)
+    assert {"mujoco-table", "impact-localisation", "scale-invariance", "fc3d-sweep",
+            "newton-first", "geometry"} <= set(names)
+
+
+def test_bench_rejects_an_unknown_benchmark():
+    with pytest.raises(SystemExit) as exit_info:
+        main(["bench", "nope"])
+    assert exit_info.value.code == 2
