@@ -17,6 +17,7 @@ from functools import cached_property
 
 from clearbench.scenarios.bodies import Body, Motion
 from clearbench.scenarios.contacts import ContactPair
+from clearbench.scenarios.dict_form import scene_to_dict
 from clearbench.scenarios.drivers import Driver
 from clearbench.scenarios.expectations import Expectation
 from clearbench.scenarios.features import (
@@ -28,6 +29,7 @@ from clearbench.scenarios.features import (
 from clearbench.scenarios.joints import ClearanceRevoluteJoint, Joint
 from clearbench.scenarios.loads import Load, Moment, PointForce
 from clearbench.scenarios.outputs import ContactForce, Output
+from clearbench.scenarios.rescaling import rescale_element
 from clearbench.scenarios.units import UnitSystem
 from clearbench.scenarios.validation import (
     ACCELERATION,
@@ -306,14 +308,10 @@ class Scene:
 
     def rescaled(self, units: UnitSystem) -> Scene:
         """The same physics expressed in ``units`` (every dimensioned value converted)."""
-        from clearbench.scenarios.serialization import rescale_element
-
         return rescale_element(self, self.units, units)
 
     @cached_property
     def content_hash(self) -> str:
         """sha256 of the canonical JSON form: identifies the physics a run was given."""
-        from clearbench.scenarios.serialization import scene_to_dict
-
         text = json.dumps(scene_to_dict(self), sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(text.encode()).hexdigest()

@@ -1,4 +1,6 @@
-"""Pass/fail of each expectation in the harness's results and report, and the analytic error.
+"""Pass/fail criteria: of each expectation in the harness's results and report, and which
+expectation figure is a run's analytic error. (The run's own verdict, ok or diverged, is
+:func:`clearbench.harness.measure.figures.measure`'s.)
 
 :func:`clearbench.harness.measure.expectation_figures.evaluate` states figures, not verdicts:
 what is acceptable depends on the use. These are the harness's criteria (shown in the report), each
@@ -34,7 +36,7 @@ import math
 from clearbench.scenarios.scales import body_size, smallest_contact_feature
 from clearbench.scenarios.scene import Scene
 
-#: kind -> figure of :mod:`.expectations` that is the run's relative error against the
+#: kind -> figure of :mod:`.expectation_figures` that is the run's relative error against the
 #: analytic solution (first one present is used), and the figure that normalises it if any.
 ANALYTIC_ERROR: dict[str, tuple[tuple[str, str | None], ...]] = {
     "bounce_apex": (("apex_max_relative_error", None),),

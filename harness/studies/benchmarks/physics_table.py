@@ -1,4 +1,5 @@
-"""Error of an engine against the physics expectations of the analytic scenes, as a table.
+"""Error of an engine against the physics expectations of the analytic scenes, as Markdown
+tables (``clearbench bench mujoco-table``).
 
 Every figure comes from :func:`clearbench.harness.measure.expectation_figures.evaluate`, the
 evaluator every engine is judged by, so a MuJoCo column and a reference-solver column are computed
