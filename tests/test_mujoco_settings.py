@@ -46,10 +46,10 @@ def test_closed_form_restitution_matches_the_ode(zeta):
 
 
 def test_unilateral_mapping_gives_the_measured_damping_ratio_for_e_08():
-    # ENGINES.md: zeta(0.8) = 0.0744 for a damper that can only push (the textbook formula
+    # docs/engines/mujoco.md: zeta(0.8) = 0.0744 for a damper that only pushes (the textbook formula
     # e = exp(-zeta pi / sqrt(1 - zeta^2)), which waits for the spring to relax, gives 0.0709).
     zeta = damping_ratio_for_restitution(0.8)
-    assert zeta == pytest.approx(0.0744, abs=5e-5)  # 4 digits as ENGINES.md states it
+    assert zeta == pytest.approx(0.0744, abs=5e-5)  # 4 digits as docs/engines/mujoco.md states it
     textbook = -math.log(0.8) / math.sqrt(math.pi**2 + math.log(0.8) ** 2)
     assert textbook == pytest.approx(0.0709, abs=5e-5)
     assert restitution_for_damping_ratio(1.0) == pytest.approx(math.exp(-2.0), rel=1e-15)
@@ -93,7 +93,7 @@ def test_contact_parameters_lengthen_the_timeconst_for_enough_steps_per_contact(
 
 def test_time_step_guard_flags_stiff_and_overdamped_constraints():
     dt = 1e-3
-    # ENGINES.md: solref "0.005 0.07" at dt 1e-3 launched a ball to 32x its drop height.
+    # docs/engines/mujoco.md: solref "0.005 0.07" at dt 1e-3 launched a ball to 32x its drop height.
     stiffness, damping = effective_stiffness_damping((0.005, 0.07), dt)
     assert stiffness * dt**2 == pytest.approx(1e-6 / (0.005 * 0.07) ** 2)
     assert any("stiffness*dt^2" in w for w in time_step_warnings("pair", (0.005, 0.07), dt))
@@ -127,7 +127,7 @@ def test_presets_and_options():
 
 
 def test_ring_errors():
-    # ENGINES.md figures for a 2.1 mm bore (C-60 scale) with a polygon of capsules:
+    # docs/engines/mujoco.md figures for a 2.1 mm bore (C-60 scale) with a polygon of capsules:
     # 41 um at N = 16 and 2.5 um at N = 64 (R (1/cos(pi/N) - 1), rounded there).
     assert ring_chord_error(2.1e-3, 16, "capsule") == pytest.approx(41e-6, rel=0.02)
     assert ring_chord_error(2.1e-3, 64, "capsule") == pytest.approx(2.5e-6, rel=0.02)

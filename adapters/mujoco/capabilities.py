@@ -221,12 +221,12 @@ def plain_capability(context: FeatureContext, name: str) -> Capability | None:
     if name == "friction":
         if settings.cone == "pyramidal":
             return _approx("pyramidal cone, soft: a body below the friction angle creeps "
-                           "(ENGINES.md: 636 um in 1 s on a 10 degree incline, mu 0.3); "
+                           "(docs/engines/mujoco.md: 636 um in 1 s, 10 deg incline, mu 0.3); "
                            "noslip has no effect with this cone")
         if settings.noslip_iterations > 0:
             return _approx(f"elliptic cone with {settings.noslip_iterations} noslip "
-                           "iterations (ENGINES.md: creep 0.06 um in 1 s at 10 iterations)")
-        return _approx("elliptic cone, soft: creeps (ENGINES.md: 444 um in 1 s)")
+                           "iterations (docs/engines/mujoco.md: creep 0.06 um in 1 s)")
+        return _approx("elliptic cone, soft: creeps (docs/engines/mujoco.md: 444 um in 1 s)")
     if name == "restitution":
         zeta_08 = damping_ratio_for_restitution(0.8, settings.plastic_damping_ratio)
         return _approx(

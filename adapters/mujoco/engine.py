@@ -6,7 +6,7 @@ Presets (each a separate engine variant ``mujoco[<preset>]``; see :mod:`.setting
 - ``default``: MuJoCo's own defaults (pyramidal cone, solref (0.02, 1), solimp
   (0.9, 0.95, 0.001), Euler, Newton, 100 iterations, no noslip);
 - ``tuned``: elliptic cone + 10 noslip iterations, solref (2 dt, 1), solimp
-  (0.99, 0.999, 1e-5) for contacts and loop closures, as ENGINES.md measured; plastic pairs
+  (0.99, 0.999, 1e-5) for contacts and loop closures (docs/engines/mujoco.md); plastic pairs
   (e = 0) mapped to dampratio 3 like every other restitution.
 
 Every pair with e > 0 gets dampratio zeta(e) of a unilateral spring-damper in both presets

@@ -240,7 +240,7 @@ class SiconosEngine(Engine):
         options.update(settings.options)
         lengths = feature_lengths(scene)
         smallest = min(lengths) if lengths else 1.0
-        # 1e-8 of the smallest feature (ENGINES.md: about 1e-8 in model units works): far
+        # 1e-8 of the smallest feature (docs/engines/siconos.md: about 1e-8 works): far
         # below what the metrics resolve, far enough above round-off that the projection loop
         # terminates.
         options.setdefault("constraint_tolerance", 1e-8 * smallest)
