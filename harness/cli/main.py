@@ -25,6 +25,7 @@ COMMAND_MODULES: tuple[str, ...] = (
     "clearbench.harness.cli.fclib",
     "clearbench.harness.cli.bench",
     "clearbench.harness.cli.c60",
+    "clearbench.harness.cli.campaign",
 )
 
 
