@@ -49,6 +49,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from clearbench.harness.run.engine_choice import RunInputError
+
 #: Sampling designs. "monte-carlo": independent pseudo-random draws (the study's method);
 #: "sobol": scrambled Sobol' points (quasi-Monte Carlo, scipy.stats.qmc); "corners": every
 #: combination of the inputs' bounds (the study's worst-case analysis, Figure 14).
@@ -64,14 +66,9 @@ _OUTPUT_KEYS = {"name", "output", "statistic", "window", "unit", "lower_limit", 
                 "limits_source", "paper"}
 
 
-class CampaignError(ValueError):
-    """A campaign file holds a bad value: names the field and the value."""
-
-    def __init__(self, field: str, value: object, reason: str):
-        self.field = field
-        self.value = value
-        self.reason = reason
-        super().__init__(f"{field} = {value!r}: {reason}")
+class CampaignError(RunInputError):
+    """A campaign file holds a bad value: names the field (``inputs[2].sigma``) and the value,
+    like every input error of a run."""
 
 
 @dataclass(frozen=True)
