@@ -207,9 +207,11 @@ def bench_mujoco_table(args: argparse.Namespace) -> int:
     if not available.available:
         raise UserError(f"mujoco is not available: {available.detail}")
     presets = args.presets or ["default", "tuned"]
-    unknown = sorted(set(presets) - set(mujoco.PRESETS))
-    if unknown:
-        raise UserError(f"unknown preset(s) {unknown}; presets: {list(mujoco.PRESETS)}")
+    for preset in presets:   # the engine's own preset check, before any run
+        try:
+            mujoco.MujocoEngine(preset)
+        except ValueError as error:
+            raise UserError(str(error)) from None
     scenes = tuple(args.scenes or physics_table.DEFAULT_SCENES)
     missing = sorted(set(scenes) - set(scene_names()))
     if missing:

@@ -13,7 +13,7 @@ import argparse
 import math
 from pathlib import Path
 
-from clearbench.adapters.reference import PRESETS
+from clearbench.adapters.reference import ReferenceEngine
 from clearbench.adapters.trajectory import Trajectory
 from clearbench.harness.c60.angles import body_angles
 from clearbench.harness.c60.validation import validate, write_figures, write_json, write_markdown
@@ -67,8 +67,10 @@ def register(subparsers) -> None:
 
 
 def run_validate(args: argparse.Namespace) -> int:
-    if args.preset not in PRESETS:
-        raise UserError(f"unknown preset {args.preset!r}; presets: {', '.join(PRESETS)}")
+    try:
+        ReferenceEngine(args.preset)   # the engine's own preset check, before any run
+    except ValueError as error:
+        raise UserError(str(error)) from None
     report = validate(cache=args.cache, preset=args.preset,
                       speed_check=not args.no_speed_check,
                       sensitivity=not args.no_sensitivity)

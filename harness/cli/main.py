@@ -17,6 +17,7 @@ import sys
 from clearbench.harness.cli import (
     bench,
     c60,
+    campaign,
     compare,
     fclib,
     regress,
@@ -31,7 +32,8 @@ from clearbench.harness.run.engine_choice import RunInputError
 from clearbench.scenarios.validation import SceneError
 
 #: Modules that each add one or more sub-commands (``register(subparsers)``), in help order.
-COMMAND_MODULES = (scenes, run, sweep, stability, compare, report, regress, fclib, bench, c60)
+COMMAND_MODULES = (scenes, run, sweep, stability, compare, report, regress, fclib, bench, c60,
+                   campaign)
 
 #: Errors that mean bad input: reported in one line, exit status 2.
 INPUT_ERRORS = (UserError, RunInputError, SceneError)
