@@ -29,7 +29,7 @@ def test_mujoco_table_compact_is_one_table(capsys):
 
 def test_mujoco_table_rejects_bad_input(capsys):
     assert main(["bench", "mujoco-table", "--preset", "fast"]) == 2
-    assert "unknown preset" in capsys.readouterr().err
+    assert "unknown mujoco preset 'fast'" in capsys.readouterr().err
     assert main(["bench", "mujoco-table", "--scene", "nope"]) == 2
     assert main(["bench", "mujoco-table", "--dt", "-1"]) == 2
     assert main(["bench", "mujoco-table", "--no-mujoco"]) == 2
