@@ -19,6 +19,7 @@ import pytest
 from scipy import stats
 
 from clearbench.harness.cli.main import main
+from clearbench.harness.report.page import write_report
 from clearbench.harness.run.store import ResultsStore
 from clearbench.harness.studies.campaign.definition import (
     SHIPPED,
@@ -290,6 +291,15 @@ def test_a_campaign_runs_on_a_local_cluster_resumes_and_reports(tmp_path):
     for suffix in (".md", ".html", ".json", ".csv"):
         assert (tmp_path / "out" / f"pendulum-test{suffix}").exists()
     assert summary["throughput"]["samples"] == 6
+    # the comparison report carries the campaign's section, figures included
+    paths = write_report(store, tmp_path / "report", c60_validation=None,
+                         campaigns=tmp_path / "out")
+    page = paths["html"].read_text()
+    assert "Tolerance campaign <code>pendulum-test</code>" in page
+    assert "data:image/png;base64" in page
+    markdown = paths["markdown"].read_text()
+    assert "## Tolerance campaign `pendulum-test`" in markdown
+    assert (tmp_path / "report" / "figures" / "pendulum-test_final_angle_histogram.png").exists()
 
 
 def _recorded_keys(log: Path) -> list[str]:

@@ -288,8 +288,9 @@ def _sensitivity_markdown(summary: dict) -> list[str]:
     return lines + [""]
 
 
-def render_html(summary: dict, pngs: dict[str, bytes]) -> str:
-    """The section as a self-contained HTML fragment page (figures embedded)."""
+def section_html(summary: dict, pngs: dict[str, bytes]) -> str:
+    """The section as an HTML fragment (figures embedded), for this report and the
+    comparison report."""
     esc = html.escape
     name = summary["definition"]["name"]
     parts = [f"<h2>Tolerance campaign <code>{esc(name)}</code></h2>"]
@@ -306,8 +307,31 @@ def render_html(summary: dict, pngs: dict[str, bytes]) -> str:
         parts.append(f"<figure><img alt='{esc(file_name)}' src='data:image/png;base64,"
                      f"{base64.b64encode(png).decode()}'><figcaption>{esc(file_name)}"
                      "</figcaption></figure>")
-    body = "\n".join(parts)
+    return "\n".join(parts)
+
+
+def render_html(summary: dict, pngs: dict[str, bytes]) -> str:
+    """The section as a self-contained HTML page."""
+    esc = html.escape
+    name = summary["definition"]["name"]
+    body = section_html(summary, pngs)
     return (f"<!doctype html><html><head><meta charset='utf-8'><title>{esc(name)}</title>"
             "<style>body{font-family:sans-serif;max-width:1200px;margin:auto}"
             "table{border-collapse:collapse;font-size:12px}td,th{border:1px solid #ccc;"
             "padding:2px 5px}</style></head><body>" + body + "</body></html>\n")
+
+
+def load_written_sections(folder: str | Path) -> list[tuple[dict, dict[str, bytes]]]:
+    """The campaign sections written by :func:`write_campaign_report` into ``folder``: each
+    summary with its figures (file name -> PNG), by campaign name."""
+    folder = Path(folder)
+    sections = []
+    for path in sorted(folder.glob("*.json")):
+        summary = json.loads(path.read_text(encoding="utf-8"))
+        if "definition" not in summary or "outputs" not in summary:
+            continue
+        name = summary["definition"]["name"]
+        pngs = {figure.name: figure.read_bytes()
+                for figure in sorted((folder / "figures").glob(f"{name}_*.png"))}
+        sections.append((summary, pngs))
+    return sections
