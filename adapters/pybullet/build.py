@@ -191,6 +191,9 @@ def _build(client, scene, settings, time_step, topology, sides, notes) -> BuiltW
     check_mass_properties(built)
     object_dynamics(built)
     body_dynamics(built)
+    # Again: a changeDynamics call on a link with a field whose C setter writes link index -1
+    # moves every field of the call to the base (docs: traps); nothing may have landed there.
+    check_mass_properties(built)
     # Warm-up step at rest: no gravity, no contact enabled, no velocity, no motor.
     for obj in objects:
         pb.setCollisionFilterGroupMask(obj.pb_body, obj.link, 0, 0, physicsClientId=client)
