@@ -5,8 +5,9 @@ Works on a world built by :mod:`.build`, in its internal units, and records with
 the scene's units).
 
 Read-out (docs/engines/pybullet.md): PyBullet reports the INERTIAL frame (centre of mass,
-principal axes) of a base (``getBasePositionAndOrientation``) or link (``getLinkState[0:2]``);
-the scene's body frame is that frame composed with the inverse of the inertial frame in the body. Velocities
+principal axes) of a base (``getBasePositionAndOrientation``) or link
+(``getLinkState[0:2]``); the scene's body frame is that frame composed with the inverse of the
+inertial frame in the body. Velocities
 (``getBaseVelocity``, ``getLinkState[6:8]``) are the centre of mass's and the angular velocity,
 world axes; the trajectory wants the angular velocity in body axes. Contact forces: for each
 pair, ``getContactPoints(A object, B object)`` of every A and B collision object; a point's
