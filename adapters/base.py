@@ -206,3 +206,47 @@ class Engine(ABC):
     @abstractmethod
     def _run(self, scene: Scene, settings: RunSettings) -> Trajectory:
         """Run a supported scene with checked options."""
+
+
+class ModuleEngine(Engine):
+    """An engine whose run options are the fields of one settings object resolved from its
+    preset (:attr:`RESOLVE_SETTINGS`), and whose capability hooks are the functions of one
+    module (:attr:`CAPABILITIES`: ``feature_context(scene, settings)``,
+    ``feature_problems(context)``, ``plain_capability``, ``shape_capability``,
+    ``joint_capability``, ``pair_capability``), as the MuJoCo and PyBullet adapters are built.
+    """
+
+    #: The engine's capabilities module.
+    CAPABILITIES: ClassVar[Any] = None
+    #: ``resolve(preset, options) -> settings`` (values checked by the settings object).
+    RESOLVE_SETTINGS: ClassVar[Any] = None
+
+    def settings(self, options: Mapping | None = None) -> Any:
+        """The preset overridden by ``options`` (names checked here, values by the settings
+        object: ValueError naming the option and value)."""
+        self.check_options(options)
+        return type(self).RESOLVE_SETTINGS(self.preset, options)
+
+    def capability_scene(self, scene: Scene, settings) -> Scene:
+        """The scene the capabilities are stated for (default: as given; an engine that
+        models it in other units returns it rescaled)."""
+        return scene
+
+    def feature_context(self, scene: Scene, options: Mapping) -> Any:
+        settings = self.settings(options)
+        return self.CAPABILITIES.feature_context(self.capability_scene(scene, settings), settings)
+
+    def feature_problems(self, context) -> Mapping[str, Sequence[str]]:
+        return self.CAPABILITIES.feature_problems(context)
+
+    def plain_capability(self, context, name: str) -> Capability | None:
+        return self.CAPABILITIES.plain_capability(context, name)
+
+    def shape_capability(self, context, kind: str) -> Capability | None:
+        return self.CAPABILITIES.shape_capability(context, kind)
+
+    def joint_capability(self, context, kind: str) -> Capability | None:
+        return self.CAPABILITIES.joint_capability(context, kind)
+
+    def pair_capability(self, context, kind_a: str, kind_b: str) -> Capability | None:
+        return self.CAPABILITIES.pair_capability(context, kind_a, kind_b)

@@ -31,10 +31,9 @@ from __future__ import annotations
 import logging
 import time
 
-from clearbench.adapters.base import Capability, Engine, RunSettings
+from clearbench.adapters.base import ModuleEngine, RunSettings
 from clearbench.adapters.mujoco import capabilities
 from clearbench.adapters.mujoco.capabilities import (
-    FeatureContext,
     bore_summary,
     clearance_summary,
     ring_summary,
@@ -69,36 +68,14 @@ def create(preset: str = "default") -> MujocoEngine:
     return MujocoEngine(preset)
 
 
-class MujocoEngine(Engine):
+class MujocoEngine(ModuleEngine):
     """MuJoCo (soft contacts, joint-coordinate trees) with a named preset."""
 
     name = "mujoco"
     PRESETS = PRESETS
     OPTION_NAMES = OPTION_NAMES
-
-    def settings(self, options: dict | None = None) -> MujocoSettings:
-        """The preset overridden by ``options`` (names checked)."""
-        self.check_options(options)
-        return resolve_settings(self.preset, options)
-
-    def feature_context(self, scene: Scene, options) -> FeatureContext:
-        return capabilities.feature_context(scene, self.settings(options))
-
-    def feature_problems(self, context: FeatureContext) -> dict[str, list[str]]:
-        return capabilities.feature_problems(context)
-
-    def plain_capability(self, context: FeatureContext, name: str) -> Capability | None:
-        return capabilities.plain_capability(context, name)
-
-    def shape_capability(self, context: FeatureContext, kind: str) -> Capability | None:
-        return capabilities.shape_capability(context, kind)
-
-    def joint_capability(self, context: FeatureContext, kind: str) -> Capability | None:
-        return capabilities.joint_capability(context, kind)
-
-    def pair_capability(self, context: FeatureContext, kind_a: str,
-                        kind_b: str) -> Capability | None:
-        return capabilities.pair_capability(context, kind_a, kind_b)
+    CAPABILITIES = capabilities
+    RESOLVE_SETTINGS = staticmethod(resolve_settings)
 
     def _run(self, scene: Scene, settings: RunSettings) -> Trajectory:
         # Lazy import of the optional engine package (mujoco) through the model builder.

@@ -14,21 +14,16 @@ import time
 
 import numpy as np
 
+from clearbench.adapters.energy_guard import EnergyGuard
 from clearbench.adapters.mujoco.settings import MujocoSettings
 from clearbench.adapters.recording import SampleRecorder
 from clearbench.adapters.trajectory import RunStatus
 from clearbench.kernels.time_profiles import evaluate_profile_slope
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.loads import LinearSpringDamper, Moment, PointForce, TorsionalSpringDamper
-from clearbench.scenarios.scales import largest_shape_dimension
 from clearbench.scenarios.scene import Scene
 
 logger = logging.getLogger(__name__)
-
-#: Expectation kinds under which the energy of the scene may not grow.
-ENERGY_EXPECTATIONS = ("energy_non_increasing", "energy_conserved")
-#: Features that do work the energy bookkeeping does not count (the guard stays off).
-WORK_FEATURES = ("drivers", "point_forces", "moments", "angle_law_loads", "distance_law_loads")
 
 
 class Runner:
@@ -57,18 +52,14 @@ class Runner:
         self.steps_taken = 0
         self.unconverged: list[int] = []
         self.warnings: list[str] = []
-        self.guard_notes: list[str] = []
         self.mujoco_warnings: dict[str, int] = {}
         self.max_contacts = 0
-        self.energy_initial = float("nan")
-        self.energy_max_gain = 0.0
-        self._kinetic_max = 0.0
         self._springs = [load for load in scene.loads if isinstance(load, LinearSpringDamper)]
         self._site_ids = [(model.site(f"{s.name}:a").id, model.site(f"{s.name}:b").id)
                           for s in self._springs]
         self._hinge_springs = built.hinge_springs
-        self._energy_guard = self._energy_guard_applies()
-        self._size_energy = self._size_energy_scale()
+        self.guard = EnergyGuard(scene, config.energy_gain_tolerance, config.guard_interval)
+        self.guard_notes = self.guard.notes
         step_times = np.arange(steps + 1) * self.dt
         self._drive = []
         for dof in built.driven:
@@ -84,27 +75,6 @@ class Runner:
                                 armature * dof.sign * acceleration))
 
     # ------------------------------------------------------------------ guards
-    def _energy_guard_applies(self) -> bool:
-        kinds = {e.kind for e in self.scene.expectations}
-        if not kinds & set(ENERGY_EXPECTATIONS):
-            self.guard_notes.append("energy guard off: no energy expectation")
-            return False
-        work = sorted(set(WORK_FEATURES) & self.scene.features)
-        if work:
-            self.guard_notes.append(f"energy guard off: {', '.join(work)} do uncounted work")
-            return False
-        self.guard_notes.append(
-            f"energy guard on: stops when energy exceeds its initial value by more than "
-            f"{self.config.energy_gain_tolerance:g} x the energy scale (largest kinetic energy "
-            f"so far, at least sum(m |g|) x largest shape size), checked every "
-            f"{self.config.guard_interval} steps and at every sample")
-        return True
-
-    def _size_energy_scale(self) -> float:
-        """sum(m |g|) over the moving bodies x the largest shape dimension [M L^2/T^2]."""
-        g = float(np.linalg.norm(self.gravity))
-        return float(np.sum(self.mass[self.movable])) * g * largest_shape_dimension(self.scene)
-
     def _check_warnings(self) -> str | None:
         counts = self.data.warning.number
         if not counts.any():
@@ -167,17 +137,15 @@ class Runner:
         return float(kinetic + potential + springs), float(kinetic)
 
     def check_energy(self) -> str | None:
-        total, kinetic = self.energy()
-        self._kinetic_max = max(self._kinetic_max, kinetic)
-        gain = total - self.energy_initial
-        scale = max(self._kinetic_max, self._size_energy, 1e-300)
-        self.energy_max_gain = max(self.energy_max_gain, gain / scale)
-        if gain > self.config.energy_gain_tolerance * scale:
-            return (f"energy gain {gain:.4g} (internal units) = {gain / scale:.3g} x the energy "
-                    f"scale at t = {self.data.time:.6g}: above the tolerance "
-                    f"{self.config.energy_gain_tolerance:g} on a scene whose energy may only "
-                    "decrease")
-        return None
+        return self.guard.check(*self.energy(), self.data.time)
+
+    @property
+    def energy_initial(self) -> float:
+        return self.guard.energy_initial
+
+    @property
+    def energy_max_gain(self) -> float:
+        return self.guard.max_gain
 
     # ------------------------------------------------------------------ loads
     def apply_loads(self) -> None:
@@ -233,9 +201,7 @@ class Runner:
         recorder = self.recorder
         self.refresh_kinematics()
         self.store()
-        self.energy_initial, kinetic = self.energy()
-        self._kinetic_max = kinetic
-        interval = self.config.guard_interval
+        self.guard.start(*self.energy())
         iterations_cap = model.opt.iterations
         for k in range(1, self.steps + 1):
             tick = time.perf_counter()
@@ -259,11 +225,11 @@ class Runner:
                                         and np.isfinite(data.qvel).all()):
                 problem = f"non-finite state at step {k} (t = {data.time:.6g})"
             recording = recorder.is_due(k)
-            checking = self._energy_guard and k % interval == 0
+            checking = self.guard.due(k)
             if problem is None and (recording or checking):
                 forces = self.contact_forces() if recording else None
                 self.refresh_kinematics()
-                if self._energy_guard:
+                if self.guard.applies:
                     problem = self.check_energy()
                 if recording:
                     self.store(forces)
