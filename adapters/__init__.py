@@ -21,6 +21,7 @@ ENGINES: dict[str, str] = {
     "reference": "clearbench.adapters.reference",
     "mujoco": "clearbench.adapters.mujoco",
     "siconos": "clearbench.adapters.siconos",
+    "exudyn": "clearbench.adapters.exudyn",
 }
 
 
