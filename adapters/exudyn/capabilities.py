@@ -17,8 +17,8 @@ from clearbench.adapters.exudyn.geometry import (
     ring_chord_error,
     ring_sphere_radius,
 )
-from clearbench.adapters.exudyn.laws import law_load_problems
 from clearbench.adapters.exudyn.settings import ExudynSettings, incline_creep
+from clearbench.ref_solver.scene_system import law_load_problems
 from clearbench.scenarios.features import pair_feature
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.shapes import SHAPE_TYPES, Arc, Bore, Circle, Cylinder

@@ -15,34 +15,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from clearbench.ref_solver.forces import element_forces, no_angle_memory, remember_angles
-from clearbench.ref_solver.scene_system import build_system
+from clearbench.ref_solver.scene_system import build_system, law_load_problems
 from clearbench.ref_solver.system import FORCE_ANGLE_LAW, FORCE_DISTANCE_LAW
 from clearbench.scenarios.loads import AngleLawLoad, DistanceLawLoad
 from clearbench.scenarios.scene import Scene
 
 LAW_KINDS = (FORCE_ANGLE_LAW, FORCE_DISTANCE_LAW)
-
-
-def law_load_problems(scene: Scene) -> list[tuple[str, str]]:
-    """(feature, reason) for every law load that cannot be evaluated (the reference's packing
-    takes angle laws of at most two bodies, applied to the law's own bodies); empty when all
-    can."""
-    out = []
-    for load in scene.loads:
-        if isinstance(load, AngleLawLoad):
-            feature, names = "angle_law_loads", load.angle_bodies
-            if len(names) > 2:
-                out.append((feature, f"{load.name}: angle law of {len(names)} bodies (the "
-                                     "shared law evaluation takes at most 2)"))
-        elif isinstance(load, DistanceLawLoad):
-            feature, names = "distance_law_loads", (load.body_a, load.body_b)
-        else:
-            continue
-        strangers = sorted({a.body for a in load.applications} - set(names))
-        if strangers:
-            out.append((feature, f"{load.name}: applied to {strangers}, not to bodies of its "
-                                 f"law {names} (the shared law evaluation cannot)"))
-    return out
 
 
 @dataclass
