@@ -22,6 +22,7 @@ ENGINES: dict[str, str] = {
     "mujoco": "clearbench.adapters.mujoco",
     "siconos": "clearbench.adapters.siconos",
     "pybullet": "clearbench.adapters.pybullet",
+    "exudyn": "clearbench.adapters.exudyn",
 }
 
 

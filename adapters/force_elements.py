@@ -15,33 +15,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from clearbench.ref_solver.forces import element_forces, no_angle_memory, remember_angles
-from clearbench.ref_solver.scene_system import build_system
-from clearbench.scenarios.loads import AngleLawLoad, DistanceLawLoad
+from clearbench.ref_solver.scene_system import build_system, law_load_problems
 from clearbench.scenarios.scene import Scene
 
 __all__ = ["ForceElements", "law_load_problems", "scene_force_elements"]
-
-
-def law_load_problems(scene: Scene) -> list[tuple[str, str]]:
-    """(feature, reason) for every law load that cannot be evaluated (the reference's packing
-    takes angle laws of at most two bodies, applied to the law's own bodies); empty when all
-    can."""
-    out = []
-    for load in scene.loads:
-        if isinstance(load, AngleLawLoad):
-            feature, names = "angle_law_loads", load.angle_bodies
-            if len(names) > 2:
-                out.append((feature, f"{load.name}: angle law of {len(names)} bodies (the "
-                                     "shared law evaluation takes at most 2)"))
-        elif isinstance(load, DistanceLawLoad):
-            feature, names = "distance_law_loads", (load.body_a, load.body_b)
-        else:
-            continue
-        strangers = sorted({a.body for a in load.applications} - set(names))
-        if strangers:
-            out.append((feature, f"{load.name}: applied to {strangers}, not to bodies of its "
-                                 f"law {names} (the shared law evaluation cannot)"))
-    return out
 
 
 @dataclass

@@ -3,8 +3,9 @@
 
 Clearance joints are expanded into their shapes and contact pairs (Scene.expanded); bodies are
 described at their centre of mass with the scene's body axes; everything stays in the scene's
-units. The reference engine builds its runs with it, and the MuJoCo adapter packs its law loads
-with it (one evaluation of the laws, :mod:`clearbench.ref_solver.forces`).
+units. The reference engine builds its runs with it, and the MuJoCo and Exudyn adapters pack
+their law loads with it (one evaluation of the laws, :mod:`clearbench.ref_solver.forces`;
+:func:`law_load_problems` says which law loads the packing cannot take).
 """
 
 from __future__ import annotations
@@ -247,3 +248,26 @@ def build_system(scene: Scene) -> MultibodySystem:
         pair_names=tuple(c.name for c in contacts),
         joint_names=tuple(j.name for j in scene.joints),
     )
+
+
+def law_load_problems(scene: Scene) -> list[tuple[str, str]]:
+    """(feature, reason) for every law load of ``scene`` that :func:`build_system`'s packing
+    cannot take (angle laws of at most two bodies, applied to the law's own bodies); empty when
+    all can. The adapters that evaluate the laws through this packing (MuJoCo, Exudyn) report
+    these as unsupported."""
+    out = []
+    for load in scene.loads:
+        if isinstance(load, AngleLawLoad):
+            feature, names = "angle_law_loads", load.angle_bodies
+            if len(names) > 2:
+                out.append((feature, f"{load.name}: angle law of {len(names)} bodies (the "
+                                     "shared law evaluation takes at most 2)"))
+        elif isinstance(load, DistanceLawLoad):
+            feature, names = "distance_law_loads", (load.body_a, load.body_b)
+        else:
+            continue
+        strangers = sorted({a.body for a in load.applications} - set(names))
+        if strangers:
+            out.append((feature, f"{load.name}: applied to {strangers}, not to bodies of its "
+                                 f"law {names} (the shared law evaluation cannot)"))
+    return out

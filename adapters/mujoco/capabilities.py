@@ -17,7 +17,6 @@ from clearbench.adapters.mujoco.geometry import (
     face_thickness,
     ring_piece_radius,
 )
-from clearbench.adapters.mujoco.laws import law_load_problems
 from clearbench.adapters.mujoco.settings import (
     MujocoSettings,
     damping_ratio_for_restitution,
@@ -27,6 +26,7 @@ from clearbench.adapters.mujoco.settings import (
 )
 from clearbench.adapters.mujoco.topology import Topology, plan_topology
 from clearbench.kernels.quaternion import quat_multiply, quat_normalize, quat_to_matrix
+from clearbench.ref_solver.scene_system import law_load_problems
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.shapes import Arc, Bore, Circle, Cylinder, Disc, Plane, Rectangle

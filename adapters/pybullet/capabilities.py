@@ -16,7 +16,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from clearbench.adapters.base import Capability, Support
-from clearbench.adapters.force_elements import law_load_problems
 from clearbench.adapters.pybullet.geometry import (
     collision_groups,
     collision_margin,
@@ -26,6 +25,7 @@ from clearbench.adapters.pybullet.geometry import (
 )
 from clearbench.adapters.pybullet.settings import PybulletSettings
 from clearbench.adapters.pybullet.topology import plan_topology
+from clearbench.ref_solver.scene_system import law_load_problems
 from clearbench.scenarios.scales import largest_length
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.shapes import Arc, Bore, Circle
