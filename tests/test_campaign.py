@@ -233,6 +233,13 @@ def test_ppm_counts_the_samples_outside_and_the_normal_tail():
     assert cap.ppm_observed == pytest.approx(2e6 * stats.norm.sf(2.0), rel=0.05)
 
 
+def test_every_sample_outside_the_limits():
+    # the C-60's FC-1 below its LSL in every run: all outside, bounds finite, Cpk negative
+    cap = capability([6.9, 7.0, 7.1], 9.0, 16.0)
+    assert cap.ppm_observed == 1e6 and cap.ppm_observed_upper == 1e6
+    assert cap.cpk.value < 0 and cap.cc < -1
+
+
 def test_no_limits_no_indices():
     cap = capability([1.0, 2.0, 3.0])
     assert cap.cp is None and cap.cpk is None and cap.cc is None and cap.ppm_normal is None

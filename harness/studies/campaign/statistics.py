@@ -114,7 +114,9 @@ def capability(values, lower: float | None = None, upper: float | None = None) -
         cc = (mean.value - 0.5 * (upper + lower)) / (0.5 * width)
         outside = int(np.count_nonzero((values < lower) | (values > upper)))
         ppm = 1e6 * outside / n
-        ppm_upper = 1e6 * float(stats.beta.ppf(CONFIDENCE, outside + 1, n - outside))
+        # Clopper-Pearson upper bound (one-sided); every sample outside: the bound is 1
+        ppm_upper = 1e6 * (float(stats.beta.ppf(CONFIDENCE, outside + 1, n - outside))
+                           if outside < n else 1.0)
         ppm_normal = 1e6 * float(stats.norm.cdf(lower, mean.value, sigma.value)
                                  + stats.norm.sf(upper, mean.value, sigma.value))
     return Capability(n, mean, sigma, float(np.min(values)), float(np.max(values)), cp, cpk,
