@@ -331,7 +331,23 @@ def load_written_sections(folder: str | Path) -> list[tuple[dict, dict[str, byte
         if "definition" not in summary or "outputs" not in summary:
             continue
         name = summary["definition"]["name"]
+        table = folder / f"{name}.csv"
+        if table.exists():  # the statistics by this code, from the samples as recorded
+            _restate_capability(summary, table)
         pngs = {figure.name: figure.read_bytes()
                 for figure in sorted((folder / "figures").glob(f"{name}_*.png"))}
         sections.append((summary, pngs))
     return sections
+
+
+def _restate_capability(summary: dict, table: Path) -> None:
+    """Recompute each output's capability from the per-sample CSV (its ok rows) with this
+    code's statistics, so a section written by an older revision shows today's figures."""
+    import pandas as pd  # lazily, as the results store does
+
+    frame = pd.read_csv(table)
+    ok = frame[frame["status"] == "ok"]
+    for entry in summary["outputs"]:
+        limits = entry["limits"] or (None, None)
+        cap = capability(ok[entry["name"]].to_numpy(dtype=float), *limits)
+        entry["capability"] = _capability_dict(cap)
