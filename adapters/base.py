@@ -1,17 +1,39 @@
-"""The contract every engine adapter implements (brax-style: same shape in every module).
+"""The contract every engine adapter implements, and the bookkeeping the base class does for it
+(scipy ``integrate/_ivp`` style: the base checks and dispatches, each engine does only its own
+part).
 
-An adapter module exposes ``availability() -> (bool, str)`` and ``create(preset) -> Engine``.
-An :class:`Engine` states per scene feature whether it supports it (natively, approximated with
-how and how large, or not with why), and runs a scene into a :class:`~.trajectory.Trajectory`.
+An engine is a subpackage of :mod:`clearbench.adapters` (listed in
+:data:`clearbench.adapters.ENGINES`) whose ``__init__`` exposes ``availability() -> (bool, str)``
+and ``create(preset) -> Engine``. Its :class:`Engine` subclass declares:
+
+- ``name`` and its presets :attr:`Engine.PRESETS` (name -> option values) and run options
+  :attr:`Engine.OPTION_NAMES`; the base refuses an unknown preset when the engine is created and
+  unknown options before anything runs (:meth:`Engine.check_options`), for every engine alike;
+- what it does with each scene feature, one feature kind at a time: the base parses every
+  feature of ``Scene.features`` once (:func:`clearbench.scenarios.features.parse_feature`) and
+  asks :meth:`Engine.plain_capability`, :meth:`Engine.shape_capability`,
+  :meth:`Engine.joint_capability` or :meth:`Engine.pair_capability`; an answer of None (the
+  engine does not know the feature) is UNSUPPORTED with the same reason in every engine
+  (:func:`unknown_feature`);
+- :meth:`Engine._run`, which runs a supported scene into a
+  :class:`~clearbench.adapters.trajectory.Trajectory` (recording it with
+  :class:`~clearbench.adapters.recording.SampleRecorder` where it steps in this process).
+
+:meth:`Engine.run` is the one entry point: options checked, unsupported scenes answered with
+an UNSUPPORTED trajectory and their reasons, then ``_run``. Failures of a run are statuses
+(crashed, diverged, ...) with messages; exceptions are for misuse (unknown preset or option).
 """
 
 from __future__ import annotations
 
 import enum
 from abc import ABC, abstractmethod
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import Any, ClassVar
 
 from clearbench.adapters.trajectory import RunStatus, Trajectory
+from clearbench.scenarios.features import FeatureKind, parse_feature
 from clearbench.scenarios.scene import Scene
 
 
@@ -27,6 +49,12 @@ class Capability:
 
     support: Support
     detail: str = ""
+
+
+def unknown_feature(engine: str, feature: str) -> Capability:
+    """The answer of every engine for a feature it does not know."""
+    return Capability(Support.UNSUPPORTED,
+                      f"the {engine} adapter does not know feature {feature!r}")
 
 
 @dataclass(frozen=True)
@@ -52,33 +80,124 @@ class RunSettings:
             raise ValueError(f"record_every must be >= 1, got {self.record_every!r}")
 
 
-class Engine(ABC):
-    """An engine (with a preset) able to run scenes."""
+@dataclass(frozen=True)
+class FeatureQuery:
+    """What the capability hooks of an engine are asked about: the scene and the run options.
+    Engines that derive more from them once per scene (a MuJoCo tree plan, resolved settings)
+    return their own object from :meth:`Engine.feature_context`."""
 
-    name: str = ""
-    preset: str = "default"
+    scene: Scene
+    options: Mapping = field(default_factory=dict)
+
+
+class Engine(ABC):
+    """An engine with a preset, able to run scenes (see the module docstring).
+
+    Parameters
+    ----------
+    preset : str
+        A key of :attr:`PRESETS`; ValueError naming the known presets otherwise.
+    """
+
+    #: Engine name, as in results (``name[preset]``).
+    name: ClassVar[str] = ""
+    #: Named presets: preset -> option values it sets (each a separate engine variant).
+    PRESETS: ClassVar[Mapping[str, Mapping]] = {"default": {}}
+    #: Names of the options a run may set (``RunSettings.options``).
+    OPTION_NAMES: ClassVar[Sequence[str]] = ()
+
+    def __init__(self, preset: str = "default"):
+        if preset not in self.PRESETS:
+            raise ValueError(f"unknown {self.name} preset {preset!r}; presets: "
+                             f"{list(self.PRESETS)}")
+        self.preset = preset
 
     @property
     def label(self) -> str:
         """``engine[preset]`` as used in results."""
         return f"{self.name}[{self.preset}]"
 
-    @abstractmethod
-    def capabilities(self, scene: Scene) -> dict[str, Capability]:
-        """Support of each feature of ``scene.features``."""
+    @classmethod
+    def check_options(cls, options: Mapping | None) -> None:
+        """ValueError naming the options of ``options`` the engine does not have."""
+        unknown = sorted(set(options or {}) - set(cls.OPTION_NAMES))
+        if unknown:
+            raise ValueError(f"unknown {cls.name} options {unknown}; options: "
+                             f"{list(cls.OPTION_NAMES)}")
 
-    def unsupported_reasons(self, scene: Scene) -> list[str]:
-        """Why the scene cannot run here (empty when it can)."""
+    # ------------------------------------------------------------------ capabilities
+    def capabilities(self, scene: Scene, options: Mapping | None = None
+                     ) -> dict[str, Capability]:
+        """Support of each feature of ``scene.features`` with the preset and ``options``."""
+        options = dict(options or {})
+        self.check_options(options)
+        context = self.feature_context(scene, options)
+        problems = self.feature_problems(context)
+        out = {}
+        for text in sorted(scene.features):
+            if problems.get(text):
+                out[text] = Capability(Support.UNSUPPORTED, "; ".join(problems[text]))
+                continue
+            feature = parse_feature(text)
+            if feature.kind is FeatureKind.PAIR:
+                capability = self.pair_capability(context, *feature.parts)
+            elif feature.kind is FeatureKind.SHAPE:
+                capability = self.shape_capability(context, *feature.parts)
+            elif feature.kind is FeatureKind.JOINT:
+                capability = self.joint_capability(context, *feature.parts)
+            else:
+                capability = self.plain_capability(context, *feature.parts)
+            out[text] = capability if capability is not None else unknown_feature(self.name,
+                                                                                  text)
+        return out
+
+    def feature_context(self, scene: Scene, options: Mapping) -> Any:
+        """What the capability hooks receive (default: a :class:`FeatureQuery`)."""
+        return FeatureQuery(scene, options)
+
+    def feature_problems(self, context) -> Mapping[str, Sequence[str]]:
+        """Features of the scene this engine cannot represent here, whatever their kind,
+        with the reasons (feature text -> reasons; default: none)."""
+        return {}
+
+    def plain_capability(self, context, name: str) -> Capability | None:
+        """Support of a plain feature (``friction``, ``drivers``, ...); None: not known."""
+        return None
+
+    def shape_capability(self, context, kind: str) -> Capability | None:
+        """Support of the shape kind ``kind`` (feature ``shape:<kind>``); None: not known."""
+        return None
+
+    def joint_capability(self, context, kind: str) -> Capability | None:
+        """Support of the ideal joint kind ``kind`` (feature ``joint:<kind>``); None: not
+        known."""
+        return None
+
+    def pair_capability(self, context, kind_a: str, kind_b: str) -> Capability | None:
+        """Support of contacts between shape kinds ``kind_a`` <= ``kind_b`` (feature
+        ``pair:<a>-<b>``); None: not known."""
+        return None
+
+    def unsupported_reasons(self, scene: Scene, options: Mapping | None = None) -> list[str]:
+        """Why the scene cannot run here with ``options`` (empty when it can)."""
         return [
             f"{feature}: {capability.detail}"
-            for feature, capability in sorted(self.capabilities(scene).items())
+            for feature, capability in sorted(self.capabilities(scene, options).items())
             if capability.support is Support.UNSUPPORTED
         ]
 
+    # ------------------------------------------------------------------ running
     def run(self, scene: Scene, settings: RunSettings | None = None) -> Trajectory:
-        """Run ``scene``; an unsupported scene gives an UNSUPPORTED trajectory, not an error."""
+        """Run ``scene``; an unsupported scene gives an UNSUPPORTED trajectory, not an error.
+
+        Raises
+        ------
+        ValueError
+            An option the engine does not have (before anything runs).
+        """
         settings = settings or RunSettings()
-        reasons = self.unsupported_reasons(scene)
+        self.check_options(settings.options)
+        reasons = self.unsupported_reasons(scene, settings.options)
         if reasons:
             return Trajectory.empty(self.name, self.preset, scene, RunStatus.UNSUPPORTED,
                                     "; ".join(reasons))
@@ -86,4 +205,48 @@ class Engine(ABC):
 
     @abstractmethod
     def _run(self, scene: Scene, settings: RunSettings) -> Trajectory:
-        """Run a supported scene."""
+        """Run a supported scene with checked options."""
+
+
+class ModuleEngine(Engine):
+    """An engine whose run options are the fields of one settings object resolved from its
+    preset (:attr:`RESOLVE_SETTINGS`), and whose capability hooks are the functions of one
+    module (:attr:`CAPABILITIES`: ``feature_context(scene, settings)``,
+    ``feature_problems(context)``, ``plain_capability``, ``shape_capability``,
+    ``joint_capability``, ``pair_capability``), as the MuJoCo and PyBullet adapters are built.
+    """
+
+    #: The engine's capabilities module.
+    CAPABILITIES: ClassVar[Any] = None
+    #: ``resolve(preset, options) -> settings`` (values checked by the settings object).
+    RESOLVE_SETTINGS: ClassVar[Any] = None
+
+    def settings(self, options: Mapping | None = None) -> Any:
+        """The preset overridden by ``options`` (names checked here, values by the settings
+        object: ValueError naming the option and value)."""
+        self.check_options(options)
+        return type(self).RESOLVE_SETTINGS(self.preset, options)
+
+    def capability_scene(self, scene: Scene, settings) -> Scene:
+        """The scene the capabilities are stated for (default: as given; an engine that
+        models it in other units returns it rescaled)."""
+        return scene
+
+    def feature_context(self, scene: Scene, options: Mapping) -> Any:
+        settings = self.settings(options)
+        return self.CAPABILITIES.feature_context(self.capability_scene(scene, settings), settings)
+
+    def feature_problems(self, context) -> Mapping[str, Sequence[str]]:
+        return self.CAPABILITIES.feature_problems(context)
+
+    def plain_capability(self, context, name: str) -> Capability | None:
+        return self.CAPABILITIES.plain_capability(context, name)
+
+    def shape_capability(self, context, kind: str) -> Capability | None:
+        return self.CAPABILITIES.shape_capability(context, kind)
+
+    def joint_capability(self, context, kind: str) -> Capability | None:
+        return self.CAPABILITIES.joint_capability(context, kind)
+
+    def pair_capability(self, context, kind_a: str, kind_b: str) -> Capability | None:
+        return self.CAPABILITIES.pair_capability(context, kind_a, kind_b)

@@ -17,6 +17,17 @@ from pathlib import Path
 import numpy as np
 
 
+def scene_fields(scene) -> dict:
+    """The fields of a :class:`Trajectory` that name its scene: ``scene_name``,
+    ``scene_hash``, ``units``, ``body_names`` and ``contact_names`` (explicit pairs, then those
+    of the clearance joints)."""
+    return {"scene_name": scene.name, "scene_hash": scene.content_hash,
+            "units": {"length": scene.units.length, "mass": scene.units.mass,
+                      "time": scene.units.time},
+            "body_names": tuple(b.name for b in scene.bodies),
+            "contact_names": tuple(c.name for c in scene.all_contacts)}
+
+
 class RunStatus(enum.Enum):
     """Outcome of a run."""
 
@@ -119,14 +130,10 @@ class Trajectory:
               time_step: float = float("nan"), metadata: dict | None = None) -> Trajectory:
         """A trajectory with no samples, carrying a non-ok outcome."""
         nb = len(scene.bodies)
-        contacts = tuple(c.name for c in scene.all_contacts)
-        nc = len(contacts)
+        nc = len(scene.all_contacts)
         return cls(
-            engine=engine, preset=preset, scene_name=scene.name, scene_hash=scene.content_hash,
-            units={"length": scene.units.length, "mass": scene.units.mass,
-                   "time": scene.units.time},
-            time_step=time_step, body_names=tuple(b.name for b in scene.bodies),
-            contact_names=contacts, times=np.zeros(0), positions=np.zeros((0, nb, 3)),
+            engine=engine, preset=preset, **scene_fields(scene), time_step=time_step,
+            times=np.zeros(0), positions=np.zeros((0, nb, 3)),
             orientations=np.zeros((0, nb, 4)), velocities=np.zeros((0, nb, 3)),
             angular_velocities=np.zeros((0, nb, 3)), contact_normal_force=np.zeros((0, nc)),
             contact_force=np.zeros((0, nc, 3)), solver_iterations=np.zeros(0, dtype=np.int64),

@@ -17,6 +17,7 @@ import numpy as np
 from numba import njit
 
 from clearbench.kernels.quaternion import quat_conjugate, quat_multiply
+from clearbench.kernels.time_profiles import profile_integral, profile_slope, profile_value
 from clearbench.ref_solver.linalg3 import cross, dot, mat_mat, mat_t_vec, mat_vec
 from clearbench.ref_solver.system import JOINT_FIXED, JOINT_PRISMATIC, JOINT_REVOLUTE, JOINT_ROWS
 from clearbench.scenarios.geometry import MAX_CONTACTS_PER_PAIR, pair_contacts
@@ -145,57 +146,11 @@ def bilateral_rows(t, x, p, rotation, fixed, joint_kind, joint_a, joint_b, ancho
 
 
 @njit(cache=True)
-def profile_value(times, values, t):
-    """Piecewise-linear profile, constant outside; right value at a jump."""
-    n = times.shape[0]
-    if t < times[0]:
-        return values[0]
-    if t >= times[n - 1]:
-        return values[n - 1]
-    for i in range(n - 1):
-        if times[i] <= t < times[i + 1]:
-            return values[i] + (t - times[i]) / (times[i + 1] - times[i]) * (
-                values[i + 1] - values[i])
-    return values[n - 1]
-
-
-@njit(cache=True)
-def profile_integral(times, values, t):
-    """Exact integral of the profile from 0 to t."""
-    total = 0.0
-    n = times.shape[0]
-    # Knots clipped to [0, t]; between consecutive knots the profile is linear.
-    knots = np.empty(n + 2)
-    knots[0] = 0.0
-    count = 1
-    for i in range(n):
-        if 0.0 < times[i] < t:
-            knots[count] = times[i]
-            count += 1
-    knots[count] = t
-    count += 1
-    for i in range(count - 1):
-        a = knots[i]
-        b = knots[i + 1]
-        if b <= a:
-            continue
-        eps = 1e-12 * max(1.0, b - a)
-        fa = profile_value(times, values, min(a + eps, b))
-        fb = profile_value(times, values, max(b - eps, a))
-        total += 0.5 * (fa + fb) * (b - a)
-    return total
-
-
-@njit(cache=True)
 def profile_rate(times, values, quantity, t):
     """Prescribed rate at t: the profile (velocity) or its slope (position)."""
     if quantity == 0:
         return profile_value(times, values, t)
-    n = times.shape[0]
-    for i in range(n - 1):
-        if times[i] <= t < times[i + 1]:
-            return (values[i + 1] - values[i]) / (times[i + 1] - times[i])
-    return 0.0
+    return profile_slope(times, values, t)
 
 
 @njit(cache=True)

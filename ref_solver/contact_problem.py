@@ -247,8 +247,9 @@ class SolverOptions:
         the residual's mean rate of decrease over the last n checks (NSGS) or iterations
         (Newton), if kept up, would not reach the tolerance within the iterations left
         (:func:`fc3d_residual.hopeless`). A solve stopped so could at best have converged by a
-        late acceleration; the reference stepper uses it (NSGS crawling at 1e-8 on a singular W
-        would otherwise run its 10,000 sweeps before the next start is tried).
+        late acceleration. Off by default, and not used by the reference stepper: its hybrid
+        chain runs every attempt to its cap (cutting NSGS short was measured on c60-trip and
+        dropped; see :meth:`MoreauJeanStepper._solve`).
     newton_direction : {"regularised", "least_norm"}
         Newton only. "regularised": (J + delta I) d = -Phi, delta from the residual;
         "least_norm": the minimum-norm least-squares solution of J d = -Phi (dense, compiled),

@@ -629,7 +629,7 @@ class MoreauJeanStepper:
             # O(h)). Ideal joints constrain the mid-step velocity, H_mid (theta v_{k+1} +
             # (1 - theta) v_k) = 0: with constant forces the step then conserves energy
             # exactly (v_mid . H^T lambda = 0), so the energy error of ideal joints is O(h^2)
-            # instead of the O(h) loss of H v_{k+1} = 0 (ENGINES.md, Siconos). In a step with
+            # instead of the O(h) loss of H v_{k+1} = 0 (docs/engines/siconos.md). In a step with
             # an impact the motion is not smooth and the mid-step prediction of the Jacobian is
             # off by O(h dv): there the joints take Moreau's law H v_{k+1} = 0, which cannot
             # create energy (it did, by 1 % on the Flores slider-crank, with the mid-step law

@@ -4,8 +4,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from clearbench.kernels.time_profiles import (
+    evaluate_profile,
+    evaluate_profile_integral,
+    evaluate_profile_slope,
+)
 from clearbench.scenarios.element import Element
-from clearbench.scenarios.time_profiles import check_profile, evaluate_profile
+from clearbench.scenarios.time_profiles import check_profile
 from clearbench.scenarios.validation import (
     ANGULAR_VELOCITY,
     DIMENSIONLESS,
@@ -69,30 +74,15 @@ class Driver(Element):
         return "xyz".index(self.component[-1])
 
     def velocity(self, t):
-        """Prescribed rate of the component at time(s) ``t`` [L/T or rad/T]."""
+        """Prescribed rate of the component at time(s) ``t`` [L/T or rad/T]: the profile of a
+        velocity driver, the slope of the current segment of a position driver."""
         if self.quantity == "velocity":
             return evaluate_profile(self.times, self.values, t)
-        import numpy as np
-
-        # Position profiles are piecewise linear: the rate is the slope of the current segment.
-        times = np.asarray(self.times)
-        values = np.asarray(self.values)
-        t_arr = np.atleast_1d(np.asarray(t, dtype=float))
-        rate = np.zeros_like(t_arr)
-        for i in range(len(times) - 1):
-            if times[i + 1] > times[i]:
-                inside = (t_arr >= times[i]) & (t_arr < times[i + 1])
-                rate[inside] = (values[i + 1] - values[i]) / (times[i + 1] - times[i])
-        return float(rate[0]) if np.ndim(t) == 0 else rate
+        return evaluate_profile_slope(self.times, self.values, t)
 
     def displacement(self, t):
-        """Prescribed displacement of the component from t = 0 [L or rad]."""
+        """Prescribed displacement of the component from t = 0 [L or rad]: the profile of a
+        position driver, the integral from 0 of a velocity driver's."""
         if self.quantity == "position":
             return evaluate_profile(self.times, self.values, t)
-        import numpy as np
-
-        from clearbench.scenarios.time_profiles import integrate_profile
-
-        if np.ndim(t) == 0:
-            return integrate_profile(self.times, self.values, 0.0, float(t))
-        return np.array([integrate_profile(self.times, self.values, 0.0, float(x)) for x in t])
+        return evaluate_profile_integral(self.times, self.values, t)

@@ -20,7 +20,3 @@ def solid_box(mass: float, half_extents: tuple[float, float, float]) -> tuple:
     return diagonal(mass * (b * b + c * c) / 3.0, mass * (a * a + c * c) / 3.0,
                     mass * (a * a + b * b) / 3.0)
 
-
-def slender_rod_x(mass: float, length: float, thickness: float) -> tuple:
-    """Thin rectangular rod along x of square section ``thickness``."""
-    return solid_box(mass, (0.5 * length, 0.5 * thickness, 0.5 * thickness))

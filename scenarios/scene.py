@@ -17,11 +17,19 @@ from functools import cached_property
 
 from clearbench.scenarios.bodies import Body, Motion
 from clearbench.scenarios.contacts import ContactPair
+from clearbench.scenarios.dict_form import scene_to_dict
 from clearbench.scenarios.drivers import Driver
 from clearbench.scenarios.expectations import Expectation
+from clearbench.scenarios.features import (
+    LOAD_FEATURES,
+    joint_feature,
+    pair_feature,
+    shape_feature,
+)
 from clearbench.scenarios.joints import ClearanceRevoluteJoint, Joint
 from clearbench.scenarios.loads import Load, Moment, PointForce
 from clearbench.scenarios.outputs import ContactForce, Output
+from clearbench.scenarios.rescaling import rescale_element
 from clearbench.scenarios.units import UnitSystem
 from clearbench.scenarios.validation import (
     ACCELERATION,
@@ -230,7 +238,8 @@ class Scene:
     # ------------------------------------------------------------------ derived
     @cached_property
     def features(self) -> frozenset[str]:
-        """Features the scene uses, derived from its content.
+        """Features the scene uses, derived from its content (written and read with
+        :mod:`clearbench.scenarios.features`).
 
         Vocabulary: ``gravity``, ``contacts``, ``friction``, ``restitution``, ``shape:<kind>``,
         ``pair:<kind>-<kind>`` (sorted), ``ideal_joints``, ``joint:<kind>``, ``closed_loop``,
@@ -251,30 +260,24 @@ class Scene:
                 features.add("friction")
             if contact.restitution > 0:
                 features.add("restitution")
-            kinds = sorted(
-                (shapes[(contact.body_a, contact.shape_a)].kind,
-                 shapes[(contact.body_b, contact.shape_b)].kind)
-            )
-            features.add(f"pair:{kinds[0]}-{kinds[1]}")
+            kinds = (shapes[(contact.body_a, contact.shape_a)].kind,
+                     shapes[(contact.body_b, contact.shape_b)].kind)
+            features.add(pair_feature(*kinds))
             for kind in kinds:
-                features.add(f"shape:{kind}")
+                features.add(shape_feature(kind))
                 if kind == "circle":
                     features.add("rings")
                 if kind == "arc":
                     features.add("arcs")
         if self.joints:
             features.add("ideal_joints")
-            features.update(f"joint:{joint.kind}" for joint in self.joints)
+            features.update(joint_feature(joint.kind) for joint in self.joints)
             if self._joint_graph_has_cycle():
                 features.add("closed_loop")
         if self.clearance_joints:
             features.add("clearance_joints")
         for load in self.loads:
-            features.add({
-                "linear_spring": "springs", "torsional_spring": "torsional_springs",
-                "point_force": "point_forces", "moment": "moments",
-                "angle_law": "angle_law_loads", "distance_law": "distance_law_loads",
-            }[load.kind])
+            features.add(LOAD_FEATURES[load.kind])
             if isinstance(load, PointForce | Moment) and (
                 load.start_time > 0 or load.end_time is not None
             ):
@@ -305,14 +308,10 @@ class Scene:
 
     def rescaled(self, units: UnitSystem) -> Scene:
         """The same physics expressed in ``units`` (every dimensioned value converted)."""
-        from clearbench.scenarios.serialization import rescale_element
-
         return rescale_element(self, self.units, units)
 
     @cached_property
     def content_hash(self) -> str:
         """sha256 of the canonical JSON form: identifies the physics a run was given."""
-        from clearbench.scenarios.serialization import scene_to_dict
-
         text = json.dumps(scene_to_dict(self), sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(text.encode()).hexdigest()

@@ -1,10 +1,11 @@
-"""Lossless conversion of scenes to and from plain dicts, JSON and TOML, and unit rescaling.
+"""Lossless conversion of scenes to and from plain dicts, JSON and TOML.
 
-The dict form is what user scene files contain: a table per scene with lists of tables for the
-elements; polymorphic elements (shapes, joints, loads, outputs) carry a ``kind`` key. ``None``
-values are omitted (TOML has no null). Reading checks every key: an unknown key or a missing
-required one is an error naming its path (``bodies[0].shapes[1].radius``), and every value goes
-through the same validation as Python-built scenes.
+The dict form (:mod:`.dict_form`, which writes it) is what user scene files contain: a table per
+scene with lists of tables for the elements; polymorphic elements (shapes, joints, loads,
+outputs) carry a ``kind`` key. ``None`` values are omitted (TOML has no null). Reading checks
+every key: an unknown key or a missing required one is an error naming its path
+(``bodies[0].shapes[1].radius``), and every value goes through the same validation as
+Python-built scenes. Unit rescaling is :mod:`.rescaling`.
 """
 
 from __future__ import annotations
@@ -13,72 +14,16 @@ import dataclasses
 import json
 import math
 import tomllib
-from enum import Enum
 from pathlib import Path
-from types import MappingProxyType
 from typing import Any
 
 from clearbench.scenarios import toml_format
 from clearbench.scenarios.bodies import Body
-from clearbench.scenarios.contacts import ContactPair
-from clearbench.scenarios.drivers import Driver
-from clearbench.scenarios.expectations import Expectation
-from clearbench.scenarios.joints import JOINT_TYPES, ClearanceRevoluteJoint
-from clearbench.scenarios.loads import LOAD_TYPES
-from clearbench.scenarios.outputs import OUTPUT_TYPES
+from clearbench.scenarios.dict_form import COLLECTIONS, scene_to_dict
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.shapes import SHAPE_TYPES
 from clearbench.scenarios.units import UnitSystem
 from clearbench.scenarios.validation import SceneError
-
-#: Element collections of a scene: key -> (kind table or single class).
-COLLECTIONS: dict[str, Any] = {
-    "bodies": Body,
-    "joints": JOINT_TYPES,
-    "clearance_joints": ClearanceRevoluteJoint,
-    "contacts": ContactPair,
-    "loads": LOAD_TYPES,
-    "drivers": Driver,
-    "outputs": OUTPUT_TYPES,
-    "expectations": Expectation,
-}
-
-
-# ---------------------------------------------------------------------------- to dict
-def _plain(value: Any) -> Any:
-    if dataclasses.is_dataclass(value):
-        return element_to_dict(value)
-    if isinstance(value, Enum):
-        return value.value
-    if isinstance(value, MappingProxyType | dict):
-        return {k: _plain(v) for k, v in value.items()}
-    if isinstance(value, tuple | list):
-        return [_plain(v) for v in value]
-    return value
-
-
-def element_to_dict(element: Any) -> dict[str, Any]:
-    """Plain-dict form of a scene element (``kind`` first for polymorphic elements)."""
-    out: dict[str, Any] = {}
-    kind = getattr(type(element), "kind", None)
-    if isinstance(kind, str) and kind and not isinstance(element, Expectation):
-        out["kind"] = kind
-    for f in dataclasses.fields(element):
-        value = getattr(element, f.name)
-        if value is None:
-            continue
-        out[f.name] = _plain(value)
-    return out
-
-
-def scene_to_dict(scene: Scene) -> dict[str, Any]:
-    """Plain-dict form of ``scene`` (JSON and TOML serialisable, lossless)."""
-    out = element_to_dict(scene)
-    out["units"] = dataclasses.asdict(scene.units)
-    for key in list(out):
-        if out[key] == [] and key in COLLECTIONS:
-            del out[key]
-    return out
 
 
 def scene_to_json(scene: Scene, indent: int | None = 2) -> str:
@@ -203,41 +148,6 @@ def load_scene_file(path: str | Path) -> Scene:
     if path.suffix == ".json":
         return scene_from_json(text)
     return scene_from_toml(text)
-
-
-# ---------------------------------------------------------------------------- rescaling
-def _scale(value: Any, factor: float) -> Any:
-    if isinstance(value, tuple):
-        return tuple(_scale(v, factor) for v in value)
-    if isinstance(value, float | int) and not isinstance(value, bool):
-        return float(value) * factor
-    return value
-
-
-def rescale_element(element: Any, source: UnitSystem, target: UnitSystem) -> Any:
-    """Copy of a scene element (or scene) with every dimensioned value converted.
-
-    Dimensions come from field metadata (``dimension``), or from the element's
-    ``field_dimension(name)`` where they depend on other fields (drivers, expectations).
-    """
-    changes: dict[str, Any] = {}
-    for f in dataclasses.fields(element):
-        value = getattr(element, f.name)
-        dynamic = getattr(element, "field_dimension", None)
-        dimension = dynamic(f.name) if dynamic else None
-        if dimension is None:
-            dimension = f.metadata.get("dimension")
-        if isinstance(dimension, dict):  # per-key dimensions of a parameter mapping
-            changes[f.name] = MappingProxyType({
-                key: v * source.factor_to(target, dimension[key]) for key, v in value.items()
-            })
-        elif dimension is not None and value is not None:
-            changes[f.name] = _scale(value, source.factor_to(target, dimension))
-        elif isinstance(value, tuple) and value and dataclasses.is_dataclass(value[0]):
-            changes[f.name] = tuple(rescale_element(v, source, target) for v in value)
-        elif isinstance(value, UnitSystem):
-            changes[f.name] = target
-    return dataclasses.replace(element, **changes)
 
 
 def is_close_scene(a: Scene, b: Scene, rtol: float = 1e-12) -> bool:

@@ -12,6 +12,8 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 
+import numpy as np
+
 #: Exponents (length, mass, time) of the physical quantities the scene description uses.
 DIMENSIONLESS = (0, 0, 0)
 LENGTH = (1, 0, 0)
@@ -150,8 +152,6 @@ def check_inertia(field: str, value: object) -> tuple[tuple[float, ...], ...]:
     Symmetry and the triangle inequality are checked relative to the largest moment, with a
     round-off allowance of 1e-9 of it.
     """
-    import numpy as np
-
     matrix = np.array(check_matrix3(field, value), dtype=float)
     scale = float(np.max(np.abs(matrix)))
     if scale == 0.0:

@@ -28,8 +28,10 @@ import time
 import numpy as np
 
 from clearbench.adapters.base import Capability, Engine, RunSettings, Support
-from clearbench.adapters.trajectory import RunStatus, Trajectory
+from clearbench.adapters.recording import record_schedule, step_count
+from clearbench.adapters.trajectory import RunStatus, Trajectory, scene_fields
 from clearbench.scenarios.bodies import Motion
+from clearbench.scenarios.features import PLAIN_FEATURES
 
 PRESETS = {"default": {}, "segfault": {}, "hang": {}, "nan": {}, "raise": {}, "energy": {}}
 OPTION_NAMES = ("sleep", "bias")
@@ -40,8 +42,6 @@ def availability() -> tuple[bool, str]:
 
 
 def create(preset: str = "default") -> FakeEngine:
-    if preset not in PRESETS:
-        raise ValueError(f"unknown fake preset {preset!r}")
     return FakeEngine(preset)
 
 
@@ -59,21 +59,28 @@ def _quat_exp(rotation: np.ndarray) -> np.ndarray:
 
 
 class FakeEngine(Engine):
+    """Knows every feature of the vocabulary: clearance joints unsupported, contacts and
+    ideal joints ignored, the rest 'native' (free flight does not look at them)."""
+
     name = "fake"
+    PRESETS = PRESETS
+    OPTION_NAMES = OPTION_NAMES
 
-    def __init__(self, preset: str = "default"):
-        self.preset = preset
+    def plain_capability(self, context, name: str) -> Capability | None:
+        if name == "clearance_joints":
+            return Capability(Support.UNSUPPORTED, "fake engine has no clearances")
+        if name in ("contacts", "ideal_joints"):
+            return Capability(Support.APPROXIMATED, "ignored (free flight only)")
+        return Capability(Support.NATIVE, "") if name in PLAIN_FEATURES else None
 
-    def capabilities(self, scene):
-        out = {}
-        for feature in scene.features:
-            if feature == "clearance_joints":
-                out[feature] = Capability(Support.UNSUPPORTED, "fake engine has no clearances")
-            elif feature in ("contacts", "ideal_joints"):
-                out[feature] = Capability(Support.APPROXIMATED, "ignored (free flight only)")
-            else:
-                out[feature] = Capability(Support.NATIVE, "")
-        return out
+    def shape_capability(self, context, kind: str) -> Capability | None:
+        return Capability(Support.NATIVE, "")
+
+    def joint_capability(self, context, kind: str) -> Capability | None:
+        return Capability(Support.NATIVE, "")
+
+    def pair_capability(self, context, kind_a: str, kind_b: str) -> Capability | None:
+        return Capability(Support.NATIVE, "")
 
     def _run(self, scene, settings: RunSettings) -> Trajectory:
         options = settings.options
@@ -89,10 +96,8 @@ class FakeEngine(Engine):
         built = time.perf_counter()
         h = settings.time_step or scene.time_step
         horizon = settings.horizon or scene.horizon
-        steps = int(math.ceil(horizon / h - 1e-9))
-        record = list(range(0, steps + 1, settings.record_every))
-        if record[-1] != steps:
-            record.append(steps)
+        steps = step_count(horizon, h)
+        record = record_schedule(steps, settings.record_every)
         nb = len(scene.bodies)
         free = np.array([b.motion is not Motion.FIXED for b in scene.bodies])
         x = np.array([b.position for b in scene.bodies], dtype=float)
@@ -127,12 +132,7 @@ class FakeEngine(Engine):
         if self.preset == "nan" or os.environ.get("CLEARBENCH_FAKE_NAN"):
             out["positions"][count // 2:] = np.nan
         return Trajectory(
-            engine=self.name, preset=self.preset, scene_name=scene.name,
-            scene_hash=scene.content_hash,
-            units={"length": scene.units.length, "mass": scene.units.mass,
-                   "time": scene.units.time},
-            time_step=h, body_names=tuple(b.name for b in scene.bodies),
-            contact_names=tuple(c.name for c in scene.all_contacts),
+            engine=self.name, preset=self.preset, **scene_fields(scene), time_step=h,
             times=np.array(record, dtype=float) * h,
             contact_normal_force=np.zeros((count, nc)), contact_force=np.zeros((count, nc, 3)),
             solver_iterations=np.zeros(count, dtype=np.int64), solver_residual=np.zeros(count),

@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from clearbench.adapters.reference.build import build_system, initial_state
 from clearbench.ref_solver.forces import applied_forces, no_angle_memory, rotation_matrices
+from clearbench.ref_solver.scene_system import build_system, initial_state
 from clearbench.scenarios.c60 import model
 from clearbench.scenarios.geometry import check_supported_pair, contacts_between
 from clearbench.scenarios.library import get_scene, scene_names

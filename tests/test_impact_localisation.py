@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from clearbench.adapters.base import RunSettings
-from clearbench.adapters.reference.build import build_system, initial_state
 from clearbench.adapters.reference.engine import create
+from clearbench.ref_solver.scene_system import build_system, initial_state
 from clearbench.ref_solver.stepper import MoreauJeanStepper, StepperSettings, crossing_fraction
 from clearbench.scenarios.library import get_scene
 

@@ -16,16 +16,15 @@ from clearbench.adapters.mujoco.engine import _internal_scene, create
 from clearbench.adapters.mujoco.geometry import (
     bore_piece_count,
     bore_radius_error,
-    quat_to_matrix,
     shape_geoms,
 )
 from clearbench.adapters.mujoco.run import Runner
 from clearbench.adapters.mujoco.settings import resolve_settings
-from clearbench.adapters.reference.build import build_system
 from clearbench.adapters.trajectory import RunStatus
 from clearbench.harness.measure import series as metrics
-from clearbench.kernels.quaternion import quat_from_axis_angle
+from clearbench.kernels.quaternion import quat_from_axis_angle, quat_to_matrix
 from clearbench.ref_solver.forces import element_forces, no_angle_memory
+from clearbench.ref_solver.scene_system import build_system
 from clearbench.scenarios.library import get_scene, scene_names
 from clearbench.scenarios.shapes import Bore
 
@@ -92,9 +91,10 @@ def test_bore_boxes_approximate_its_radius_within_the_stated_error(start, end, p
     error = bore_radius_error(bore, settings)
     step = (end - start) / count
     assert error == pytest.approx(radius * (1.0 / math.cos(0.5 * step) - 1.0), rel=1e-15)
-    frame = quat_to_matrix(bore.orientation)
+    frame = quat_to_matrix(np.asarray(bore.orientation))
     centre = np.asarray(bore.position)
-    boxes = [(np.asarray(g.position), quat_to_matrix(g.orientation), np.asarray(g.size))
+    boxes = [(np.asarray(g.position), quat_to_matrix(np.asarray(g.orientation)),
+              np.asarray(g.size))
              for g in geoms]
     assert all(g.kind == "box" for g in geoms)
     # Angles of every box's middle and corners, and between them; heights over the length.
@@ -169,7 +169,7 @@ def test_the_run_loop_applies_the_law_loads_and_the_moment_every_step():
     scene = get_scene("c60-on")
     settings = resolve_settings("tuned")
     built = _perturbed_model(scene)
-    runner = Runner(_internal_scene(scene, settings), built, settings, steps=1, samples=2)
+    runner = Runner(_internal_scene(scene, settings), built, settings, steps=1, record_every=1)
     mujoco.mj_step1(built.model, built.data)
     runner.apply_loads()
     expected = built.law_forces.wrenches(built.data)

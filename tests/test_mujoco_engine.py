@@ -133,7 +133,7 @@ def test_box_sticking_on_an_incline_gets_friction_along_the_slope():
 
 def test_energy_guard_stops_a_run_with_a_too_stiff_contact():
     scene = get_scene("bouncing-ball-e0")
-    # ENGINES.md: solref 0.005 0.07 at dt 1e-3 launched a dropped ball to 32x its height.
+    # docs/engines/mujoco.md: solref 0.005 0.07 at dt 1e-3 launched a dropped ball 32x its height.
     trajectory = create("default").run(scene, RunSettings(options={"solref": (0.005, 0.07)}))
     assert trajectory.status is RunStatus.DIVERGED
     assert "energy gain" in trajectory.message

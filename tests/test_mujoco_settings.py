@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from clearbench.adapters.mujoco.run import profile_integral, profile_slope
+from clearbench.adapters.mujoco.engine import create
 from clearbench.adapters.mujoco.settings import (
     PRESETS,
     contact_parameters,
@@ -21,7 +21,6 @@ from clearbench.adapters.mujoco.settings import (
     ring_clearance_error,
     time_step_warnings,
 )
-from clearbench.scenarios.drivers import Driver
 
 
 def _restitution_by_ode(zeta: float) -> float:
@@ -47,10 +46,10 @@ def test_closed_form_restitution_matches_the_ode(zeta):
 
 
 def test_unilateral_mapping_gives_the_measured_damping_ratio_for_e_08():
-    # ENGINES.md: zeta(0.8) = 0.0744 for a damper that can only push (the textbook formula
+    # docs/engines/mujoco.md: zeta(0.8) = 0.0744 for a damper that only pushes (the textbook formula
     # e = exp(-zeta pi / sqrt(1 - zeta^2)), which waits for the spring to relax, gives 0.0709).
     zeta = damping_ratio_for_restitution(0.8)
-    assert zeta == pytest.approx(0.0744, abs=5e-5)  # 4 digits as ENGINES.md states it
+    assert zeta == pytest.approx(0.0744, abs=5e-5)  # 4 digits as docs/engines/mujoco.md states it
     textbook = -math.log(0.8) / math.sqrt(math.pi**2 + math.log(0.8) ** 2)
     assert textbook == pytest.approx(0.0709, abs=5e-5)
     assert restitution_for_damping_ratio(1.0) == pytest.approx(math.exp(-2.0), rel=1e-15)
@@ -94,7 +93,7 @@ def test_contact_parameters_lengthen_the_timeconst_for_enough_steps_per_contact(
 
 def test_time_step_guard_flags_stiff_and_overdamped_constraints():
     dt = 1e-3
-    # ENGINES.md: solref "0.005 0.07" at dt 1e-3 launched a ball to 32x its drop height.
+    # docs/engines/mujoco.md: solref "0.005 0.07" at dt 1e-3 launched a ball to 32x its drop height.
     stiffness, damping = effective_stiffness_damping((0.005, 0.07), dt)
     assert stiffness * dt**2 == pytest.approx(1e-6 / (0.005 * 0.07) ** 2)
     assert any("stiffness*dt^2" in w for w in time_step_warnings("pair", (0.005, 0.07), dt))
@@ -120,15 +119,15 @@ def test_presets_and_options():
     # An explicit solref replaces the step-relative timeconst of the preset.
     assert resolve_settings("tuned", {"solref": (0.005, 0.07)}).contact_timeconst(1e-3) == 0.005
     with pytest.raises(ValueError, match="unknown mujoco options"):
-        resolve_settings("tuned", {"solref_typo": 1})
+        create("tuned").settings({"solref_typo": 1})
     with pytest.raises(ValueError, match="unknown mujoco preset"):
-        resolve_settings("fast")
+        create("fast")
     with pytest.raises(ValueError, match="cone"):
         resolve_settings("default", {"cone": "round"})
 
 
 def test_ring_errors():
-    # ENGINES.md figures for a 2.1 mm bore (C-60 scale) with a polygon of capsules:
+    # docs/engines/mujoco.md figures for a 2.1 mm bore (C-60 scale) with a polygon of capsules:
     # 41 um at N = 16 and 2.5 um at N = 64 (R (1/cos(pi/N) - 1), rounded there).
     assert ring_chord_error(2.1e-3, 16, "capsule") == pytest.approx(41e-6, rel=0.02)
     assert ring_chord_error(2.1e-3, 64, "capsule") == pytest.approx(2.5e-6, rel=0.02)
@@ -139,23 +138,3 @@ def test_ring_errors():
     for piece in ("sphere", "capsule"):
         extra = ring_clearance_error(2.1e-3, 21e-6, 64, piece)
         assert 0 < extra == pytest.approx(21e-6 * (math.pi / 64) ** 2 / 2, rel=0.05)
-
-
-@pytest.mark.parametrize("times, values", [
-    ((0.0,), (2.0,)),
-    ((0.0, 0.7, 0.7, 2.0), (0.0, 0.0, 0.2, 0.2)),      # switched on at 0.7 (the C-60 plunger)
-    ((0.1, 0.5, 0.9, 0.9, 1.5), (1.0, -2.0, 3.0, 0.5, 0.0)),
-])
-def test_driver_profile_integral_and_slope(times, values):
-    driver = Driver("d", body="b", component="x", quantity="velocity", times=times,
-                    values=values)
-    t = np.linspace(0.0, 2.5, 251)
-    exact = np.array([driver.displacement(float(x)) for x in t])
-    # Both exact for piecewise-linear profiles: only round-off differs.
-    assert np.allclose(profile_integral(times, values, t), exact, rtol=1e-12, atol=1e-12)
-    slope = profile_slope(times, values, t)
-    h = 1e-7
-    numeric = (np.asarray(driver.velocity(t + h)) - np.asarray(driver.velocity(t))) / h
-    away_from_knots = np.min(np.abs(t[:, None] - np.asarray(times)[None, :]), axis=1) > 1e-3
-    # Forward difference of a linear segment: exact up to round-off (1e-7 step, O(1) values).
-    assert np.allclose(slope[away_from_knots], numeric[away_from_knots], atol=1e-6)

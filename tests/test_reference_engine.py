@@ -161,7 +161,7 @@ CLEARANCE_LADDER = ((1e-3, 1e-3), (1e-4, 3e-4), (1e-5, 1e-4))
 
 
 def test_clearance_pendulum_approaches_the_ideal_pendulum():
-    from clearbench.harness.studies.benchmarks import clearance_ladder
+    from clearbench.harness.studies.benchmarks.clearance_ladder import clearance_ladder
 
     errors = [rung.angle_error for rung in clearance_ladder(0.3, CLEARANCE_LADDER)]
     # The difference from the ideal pendulum goes to zero with the clearance: each rung

@@ -13,9 +13,9 @@ import math
 import numpy as np
 import pytest
 
+from clearbench.adapters import engine_availability
 from clearbench.adapters.base import RunSettings, Support
 from clearbench.adapters.reference.engine import create as create_reference
-from clearbench.adapters.registry import engine_availability
 from clearbench.adapters.siconos import engine as siconos_engine
 from clearbench.adapters.siconos import process as siconos_process
 from clearbench.adapters.trajectory import RunStatus, Trajectory
@@ -248,7 +248,7 @@ def test_driven_slider_crank_follows_the_closed_form_kinematics():
 
 @requires_siconos
 def test_ideal_joints_lose_energy_at_first_order_in_h():
-    # Documented Siconos behaviour (ENGINES.md): the pendulum on a PivotJointR loses energy
+    # Siconos behaviour (docs/engines/siconos.md): the pendulum on a PivotJointR loses energy
     # O(h) under MoreauJeanOSI (0.92 % in 2 s at h = 1e-3), where the reference is O(h^2).
     scene = get_scene("pendulum")
     losses = []

@@ -20,11 +20,12 @@ import numpy as np
 import pytest
 
 from clearbench.adapters.base import RunSettings, Support
-from clearbench.adapters.reference.build import build_system
 from clearbench.adapters.siconos import engine as siconos_engine
 from clearbench.adapters.trajectory import RunStatus
 from clearbench.kernels.quaternion import quat_normalize, quat_to_matrix
+from clearbench.kernels.time_profiles import evaluate_profile, evaluate_profile_slope
 from clearbench.ref_solver.forces import applied_forces, no_angle_memory, rotation_matrices
+from clearbench.ref_solver.scene_system import build_system
 from clearbench.scenarios.library import get_scene, scene_names
 from clearbench.scenarios.loads import AngleLawLoad, DistanceLawLoad, LoadApplication
 from clearbench.scenarios.scene import Scene
@@ -182,3 +183,18 @@ def test_projection_refuses_pairs_that_drop_candidates():
         scene, RunSettings(options={"projection": True}))
     assert trajectory.status is RunStatus.UNSUPPORTED
     assert "pair:arc-bore" in trajectory.message
+
+
+@pytest.mark.parametrize("times, values", [
+    ((0.0,), (2.0,)),
+    ((0.0, 0.7, 0.7, 2.0), (0.0, 0.0, 0.2, 0.2)),      # switched on at 0.7 (the C-60 plunger)
+    ((0.1, 0.5, 0.9, 0.9, 1.5), (1.0, -2.0, 3.0, 0.5, 0.0)),
+])
+def test_worker_time_profiles_are_the_floor_kernels(worker, times, values):
+    """The worker's copies of the profile value and slope (it cannot import clearbench) give
+    bitwise the values of :mod:`clearbench.kernels.time_profiles`, knots and jumps included."""
+    t = np.concatenate((np.linspace(-0.5, 2.5, 301), times))
+    assert [worker.evaluate_profile(times, values, x) for x in t] == \
+        evaluate_profile(times, values, t).tolist()
+    assert [worker.profile_rate(times, values, x) for x in t] == \
+        evaluate_profile_slope(times, values, t).tolist()

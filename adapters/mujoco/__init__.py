@@ -1,5 +1,5 @@
 """The MuJoCo engine: a scene rebuilt in MuJoCo, stepped with guards, read out."""
 
-from clearbench.adapters.mujoco.engine import OPTION_NAMES, PRESETS, availability, create
+from clearbench.adapters.mujoco.engine import MujocoEngine, availability, create
 
-__all__ = ["OPTION_NAMES", "PRESETS", "availability", "create"]
+__all__ = ["MujocoEngine", "availability", "create"]

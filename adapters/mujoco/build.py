@@ -1,6 +1,6 @@
 """Scene -> compiled MuJoCo model (MjSpec), with the maps the run loop needs.
 
-The scene is expected in the model's internal units (see :mod:`.mujoco_engine`). Clearance
+The scene is expected in the model's internal units (see :mod:`.engine`). Clearance
 joints are expanded into their shapes and contact pairs (Scene.expanded). Every MuJoCo body
 frame is the scene's body frame; its inertial frame (centre of mass, principal axes) is set
 from the scene's centre of mass and inertia tensor, and MuJoCo diagonalises it. Geoms have
@@ -19,11 +19,7 @@ from clearbench.adapters.mujoco.geometry import (
     GeomSpec,
     PairSpec,
     RingInfo,
-    quat_multiply,
-    quat_to_matrix,
-    scene_length_scale,
     shape_geoms,
-    smallest_feature_length,
 )
 from clearbench.adapters.mujoco.laws import LawForces, law_forces
 from clearbench.adapters.mujoco.settings import (
@@ -33,6 +29,12 @@ from clearbench.adapters.mujoco.settings import (
     time_step_warnings,
 )
 from clearbench.adapters.mujoco.topology import Topology, plan_topology
+from clearbench.kernels.quaternion import (
+    quat_conjugate,
+    quat_multiply,
+    quat_normalize,
+    quat_to_matrix,
+)
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.loads import (
     AngleLawLoad,
@@ -42,6 +44,7 @@ from clearbench.scenarios.loads import (
     PointForce,
     TorsionalSpringDamper,
 )
+from clearbench.scenarios.scales import largest_length, smallest_feature_length
 from clearbench.scenarios.scene import Scene
 
 INTEGRATORS = {"Euler": mujoco.mjtIntegrator.mjINT_EULER,
@@ -104,15 +107,14 @@ def _relative_pose(parent_pose, child_pose) -> tuple[np.ndarray, np.ndarray]:
     """Pose of the child frame in the parent frame."""
     (xp, qp), (xc, qc) = parent_pose, child_pose
     rotation = quat_to_matrix(qp)
-    conjugate = np.array([qp[0], -qp[1], -qp[2], -qp[3]])
-    return rotation.T @ (xc - xp), quat_multiply(conjugate, qc)
+    return rotation.T @ (xc - xp), quat_multiply(quat_conjugate(qp), qc)
 
 
 def _world_poses(scene: Scene) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     out = {}
     for body in scene.bodies:
-        q = np.asarray(body.orientation, dtype=float)
-        out[body.name] = (np.asarray(body.position, dtype=float), q / np.linalg.norm(q))
+        out[body.name] = (np.asarray(body.position, dtype=float),
+                          quat_normalize(np.asarray(body.orientation, dtype=float)))
     return out
 
 
@@ -124,7 +126,7 @@ def build_model(scene: Scene, settings: MujocoSettings, time_step: float) -> Bui
         reasons = "; ".join(f"{feature}: {why}" for feature, why in topology.problems)
         raise ValueError(f"scene {scene.name!r} cannot be built in MuJoCo: {reasons}")
     poses = _world_poses(scene)
-    length_scale = scene_length_scale(scene)
+    length_scale = largest_length(scene)
     spec = mujoco.MjSpec()
     spec.modelname = scene.name
     spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_FALSE
@@ -317,7 +319,7 @@ def _add_loads(spec, scene: Scene, topology: Topology, poses, spec_bodies, warni
                time_step: float):
     """Springs as tendons / joint stiffness, preloads as motor actuators; point forces,
     moments and other torsional springs as Python loads applied every step (law loads are
-    left to :func:`.mujoco_laws.law_forces`)."""
+    left to :func:`.laws.law_forces`)."""
     python_loads: list[PythonLoad] = []
     controls: list[tuple[str, float]] = []
     hinge_springs: list[tuple] = []
@@ -366,7 +368,7 @@ def _add_loads(spec, scene: Scene, topology: Topology, poses, spec_bodies, warni
         elif isinstance(load, PointForce | Moment):
             python_loads.append(PythonLoad(load, -1))
         elif isinstance(load, AngleLawLoad | DistanceLawLoad):
-            continue  # evaluated by the reference's force function (mujoco_laws)
+            continue  # evaluated by the reference's force function (laws.py)
         else:  # pragma: no cover - every load kind is handled above
             raise TypeError(f"unhandled load kind {load.kind!r}")
     return python_loads, controls, hinge_springs

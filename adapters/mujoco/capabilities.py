@@ -1,9 +1,12 @@
 """What the MuJoCo adapter does with each scene feature: native, approximated (how, how
-large) or unsupported (why). Pure Python: stated without compiling a model."""
+large) or unsupported (why), one function per feature kind, asked by
+:meth:`clearbench.adapters.base.Engine.capabilities`. Pure Python: stated without compiling a
+model."""
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -14,7 +17,6 @@ from clearbench.adapters.mujoco.geometry import (
     face_thickness,
     ring_piece_radius,
 )
-from clearbench.adapters.mujoco.laws import law_load_problems
 from clearbench.adapters.mujoco.settings import (
     MujocoSettings,
     damping_ratio_for_restitution,
@@ -22,8 +24,9 @@ from clearbench.adapters.mujoco.settings import (
     ring_chord_error,
     ring_clearance_error,
 )
-from clearbench.adapters.mujoco.topology import plan_topology
-from clearbench.kernels.quaternion import quat_multiply, quat_to_matrix
+from clearbench.adapters.mujoco.topology import Topology, plan_topology
+from clearbench.kernels.quaternion import quat_multiply, quat_normalize, quat_to_matrix
+from clearbench.ref_solver.scene_system import law_load_problems
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.shapes import Arc, Bore, Circle, Cylinder, Disc, Plane, Rectangle
@@ -101,7 +104,7 @@ def _axis_world(scene: Scene, body_name: str, shape) -> np.ndarray:
     body = scene.expanded.body(body_name)
     q = quat_multiply(np.asarray(body.orientation, dtype=float),
                       np.asarray(shape.orientation, dtype=float))
-    return quat_to_matrix(q / np.linalg.norm(q))[:, 2]
+    return quat_to_matrix(quat_normalize(q))[:, 2]
 
 
 def journal_clearances(scene: Scene, body_name: str, shape) -> list[tuple[str, float | None]]:
@@ -174,134 +177,96 @@ def face_summary(scene: Scene, settings: MujocoSettings, kind: type) -> list[str
     return out
 
 
-def mujoco_capabilities(scene: Scene, settings: MujocoSettings) -> dict[str, Capability]:
-    """Capability of every feature in ``scene.features``."""
+@dataclass(frozen=True)
+class FeatureContext:
+    """What the MuJoCo capabilities of one scene are derived from (computed once per scene)."""
+
+    scene: Scene
+    settings: MujocoSettings
+    topology: Topology
+    closures: frozenset       # names of the loop-closing joints (soft equalities)
+    joint_kind: dict          # joint name -> kind
+    moving_planes: tuple      # "body/shape" of the planes on moving bodies
+
+
+def feature_context(scene: Scene, settings: MujocoSettings) -> FeatureContext:
+    """The tree plan and the facts the capabilities of ``scene`` need."""
     topology = plan_topology(scene)
+    moving_planes = tuple(f"{b.name}/{s.name}" for b in scene.expanded.bodies for s in b.shapes
+                          if isinstance(s, Plane) and b.motion is not Motion.FIXED)
+    return FeatureContext(scene, settings, topology, frozenset(topology.closures),
+                          {j.name: j.kind for j in scene.joints}, moving_planes)
+
+
+def feature_problems(context: FeatureContext) -> dict[str, list[str]]:
+    """Features MuJoCo cannot represent for this scene (the tree plan's and the law loads'
+    problems), with the reasons."""
     problems: dict[str, list[str]] = {}
-    for feature, reason in topology.problems:
+    for feature, reason in (*context.topology.problems, *law_load_problems(context.scene)):
         problems.setdefault(feature, []).append(reason)
-    for feature, reason in law_load_problems(scene):
-        problems.setdefault(feature, []).append(reason)
-    closures = set(topology.closures)
-    joint_kind = {j.name: j.kind for j in scene.joints}
-    moving_planes = [f"{b.name}/{s.name}" for b in scene.expanded.bodies for s in b.shapes
-                     if isinstance(s, Plane) and b.motion is not Motion.FIXED]
-    out: dict[str, Capability] = {}
-    for feature in sorted(scene.features):
-        if feature in problems:
-            out[feature] = Capability(Support.UNSUPPORTED, "; ".join(problems[feature]))
-            continue
-        out[feature] = _feature(feature, scene, settings, topology, closures, joint_kind,
-                                moving_planes)
-    return out
+    return problems
 
 
-def _feature(feature, scene, settings, topology, closures, joint_kind, moving_planes):
-    if feature in ("gravity", "fixed_bodies"):
-        return _native("gravity option" if feature == "gravity" else "static bodies")
-    if feature == "contacts":
+def plain_capability(context: FeatureContext, name: str) -> Capability | None:
+    """Support of a plain feature; None for one the adapter does not know."""
+    settings = context.settings
+    if name in ("gravity", "fixed_bodies"):
+        return _native("gravity option" if name == "gravity" else "static bodies")
+    if name == "contacts":
         return _approx(
             "one <pair> per scene pair and geom piece (contype = conaffinity = 0, so nothing "
             "else collides); MuJoCo contacts are soft constraints that let the gap go below "
             f"zero (solref {describe_solref(settings.solref, settings.timeconst_steps)}, "
             f"solimp {settings.solimp[:3]}); a pair's offset is its MuJoCo pair margin")
-    if feature == "friction":
+    if name == "friction":
         if settings.cone == "pyramidal":
             return _approx("pyramidal cone, soft: a body below the friction angle creeps "
-                           "(ENGINES.md: 636 um in 1 s on a 10 degree incline, mu 0.3); "
+                           "(docs/engines/mujoco.md: 636 um in 1 s, 10 deg incline, mu 0.3); "
                            "noslip has no effect with this cone")
         if settings.noslip_iterations > 0:
             return _approx(f"elliptic cone with {settings.noslip_iterations} noslip "
-                           "iterations (ENGINES.md: creep 0.06 um in 1 s at 10 iterations)")
-        return _approx("elliptic cone, soft: creeps (ENGINES.md: 444 um in 1 s)")
-    if feature == "restitution":
+                           "iterations (docs/engines/mujoco.md: creep 0.06 um in 1 s)")
+        return _approx("elliptic cone, soft: creeps (docs/engines/mujoco.md: 444 um in 1 s)")
+    if name == "restitution":
         zeta_08 = damping_ratio_for_restitution(0.8, settings.plastic_damping_ratio)
         return _approx(
             "MuJoCo has no restitution parameter: e becomes the dampratio of a unilateral "
             f"spring-damper (zeta(0.8) = {zeta_08:.4f}), constant impedance, timeconst long "
             f"enough for {settings.restitution_contact_steps:g} steps per contact (softer "
             "contacts, deeper penetration); pairs with " + describe_plastic(settings))
-    if feature.startswith("shape:"):
-        kind = feature[6:]
-        if kind in NATIVE_SHAPES:
-            return _native(f"MuJoCo {NATIVE_SHAPES[kind]}")
-        if kind == "cylinder":
-            return _native("MuJoCo cylinder (its flat end caps collide too; the scene's "
-                           "cylinder touches on its lateral surface only)")
-        if kind == "plane":
-            if moving_planes:
-                return _approx(
-                    "MuJoCo plane on fixed bodies; on moving bodies (MuJoCo planes must be "
-                    f"static) a cube of half size {settings.plane_box_size:g} x the scene "
-                    f"size whose face is the plane: {', '.join(moving_planes)}")
-            return _native("MuJoCo plane")
-        if kind == "rectangle":
-            return _approx("box whose +z face is the rectangle, as thick as the shape's depth "
-                           f"(else {settings.face_thickness:g} x its larger half extent); its "
-                           "edges and sides collide too (the scene's rectangle contacts on "
-                           "its face only): " + "; ".join(face_summary(scene, settings,
-                                                                        Rectangle)))
-        if kind == "disc":
-            return _approx("cylinder whose +z end cap is the disc, as thick as the shape's "
-                           f"depth (else {settings.face_thickness:g} x its radius); its rim "
-                           "and edge collide too: " + "; ".join(face_summary(scene, settings,
-                                                                              Disc)))
-        if kind == "bore":
-            return _approx(
-                f"MuJoCo geoms are convex: {settings.bore_pieces} boxes per full circle line "
-                "the hole, their inner faces the circumscribed polygon (apothem R), so the "
-                "hole is up to R (1/cos(pi/N) - 1) larger at the corners; the boxes' end faces "
-                "collide too (beyond the bore's angles and length): "
-                + "; ".join(bore_summary(scene, settings)))
-        if kind in ("circle", "arc"):
-            return _approx(f"ring of {settings.ring_pieces} {settings.ring_piece}s per full "
-                           "circle: " + "; ".join(ring_summary(scene, settings)))
-    if feature in ("rings", "arcs"):
+    if name in ("rings", "arcs"):
         return _approx(f"{settings.ring_pieces} {settings.ring_piece}s per full circle "
                        "(see shape:circle / shape:arc)")
-    if feature.startswith("pair:"):
-        return _native("MuJoCo collision function for the two geom types (one pair per "
-                       "piece of a ring)")
-    if feature == "ideal_joints":
-        if closures:
+    if name == "ideal_joints":
+        if context.closures:
             return _approx("tree joints (exact) on a spanning tree; loops closed by soft "
-                           f"equalities: {', '.join(sorted(closures))}")
+                           f"equalities: {', '.join(sorted(context.closures))}")
         return _native("tree joints (hinge / slide / ball / welded child): exact")
-    if feature.startswith("joint:"):
-        kind = feature[6:]
-        soft = sorted(name for name in closures if joint_kind[name] == kind)
-        if soft:
-            how = {"revolute": "two connect equalities on the axis",
-                   "spherical": "one connect equality", "fixed": "one weld equality"}[kind]
-            return _approx(f"tree {kind} joints exact; loop-closing ones ({', '.join(soft)}) "
-                           f"as {how} (soft, drift)")
-        return _native({"revolute": "hinge", "prismatic": "slide", "spherical": "ball",
-                        "fixed": "child welded to its parent"}[kind] + " in the tree: exact")
-    if feature == "closed_loop":
+    if name == "closed_loop":
         solref = describe_solref(settings.equality_solref, settings.equality_timeconst_steps)
         return _approx(f"loop-closing joints are soft equalities (solref {solref}): they drift")
-    if feature == "clearance_joints":
+    if name == "clearance_joints":
         return _approx("journal cylinder against bearing rings and flange planes against "
                        "thrust rings, rings as convex pieces: " +
-                       "; ".join(clearance_summary(scene, settings)))
-    if feature == "springs":
+                       "; ".join(clearance_summary(context.scene, settings)))
+    if name == "springs":
         return _native("spatial tendon between two sites (stiffness, damping, springlength); "
                        "preload as a constant motor force on the tendon")
-    if feature == "torsional_springs":
+    if name == "torsional_springs":
         return _approx("joint stiffness/damping where a tree hinge joins the two bodies about "
                        "the spring axis (exact); otherwise an explicit moment from the "
                        "relative rotation, applied before every step")
-    if feature in ("angle_law_loads", "distance_law_loads"):
+    if name in ("angle_law_loads", "distance_law_loads"):
         return _approx("explicit, one step lag: the reference solver's own force function "
                        "(ref_solver.forces.element_forces) evaluated at the configuration of "
                        "each step start, applied as xfrc_applied during the step")
-    if feature in ("point_forces", "moments"):
+    if name in ("point_forces", "moments"):
         return _native("xfrc_applied at the centre of mass (with the moment of the offset), "
                        "set before every step")
-    if feature == "time_switched_loads":
+    if name == "time_switched_loads":
         return _approx("switched at the first step that starts inside the window "
                        "(resolution one time step)")
-    if feature == "drivers":
+    if name == "drivers":
         return _approx(
             "each driven component is a joint of the body (hinge / slide to a fixed body, or "
             "world slides; a body whose three rotations are held at zero has no rotational "
@@ -310,4 +275,70 @@ def _feature(feature, scene, settings, topology, closures, joint_kind, moving_pl
             "the profile before every step (exact at step starts; reactions from the "
             "dynamics). Not mocap bodies: MuJoCo gives them no velocity, so contacts and "
             "joined bodies would not see the motion")
-    return Capability(Support.UNSUPPORTED, "feature not handled by the MuJoCo adapter")
+    return None
+
+
+def shape_capability(context: FeatureContext, kind: str) -> Capability | None:
+    """Support of a shape kind; None for one the adapter does not know."""
+    scene, settings = context.scene, context.settings
+    if kind in NATIVE_SHAPES:
+        return _native(f"MuJoCo {NATIVE_SHAPES[kind]}")
+    if kind == "cylinder":
+        return _native("MuJoCo cylinder (its flat end caps collide too; the scene's "
+                       "cylinder touches on its lateral surface only)")
+    if kind == "plane":
+        if context.moving_planes:
+            return _approx(
+                "MuJoCo plane on fixed bodies; on moving bodies (MuJoCo planes must be "
+                f"static) a cube of half size {settings.plane_box_size:g} x the scene "
+                f"size whose face is the plane: {', '.join(context.moving_planes)}")
+        return _native("MuJoCo plane")
+    if kind == "rectangle":
+        return _approx("box whose +z face is the rectangle, as thick as the shape's depth "
+                       f"(else {settings.face_thickness:g} x its larger half extent); its "
+                       "edges and sides collide too (the scene's rectangle contacts on "
+                       "its face only): " + "; ".join(face_summary(scene, settings,
+                                                                    Rectangle)))
+    if kind == "disc":
+        return _approx("cylinder whose +z end cap is the disc, as thick as the shape's "
+                       f"depth (else {settings.face_thickness:g} x its radius); its rim "
+                       "and edge collide too: " + "; ".join(face_summary(scene, settings,
+                                                                          Disc)))
+    if kind == "bore":
+        return _approx(
+            f"MuJoCo geoms are convex: {settings.bore_pieces} boxes per full circle line "
+            "the hole, their inner faces the circumscribed polygon (apothem R), so the "
+            "hole is up to R (1/cos(pi/N) - 1) larger at the corners; the boxes' end faces "
+            "collide too (beyond the bore's angles and length): "
+            + "; ".join(bore_summary(scene, settings)))
+    if kind in ("circle", "arc"):
+        return _approx(f"ring of {settings.ring_pieces} {settings.ring_piece}s per full "
+                       "circle: " + "; ".join(ring_summary(scene, settings)))
+    return None
+
+
+def pair_capability(context: FeatureContext, kind_a: str, kind_b: str) -> Capability | None:
+    """Support of a pair of shape kinds: native between shapes the adapter knows (each a
+    geom, or a ring of geom pieces); None otherwise."""
+    if shape_capability(context, kind_a) is None or shape_capability(context, kind_b) is None:
+        return None
+    return _native("MuJoCo collision function for the two geom types (one pair per "
+                   "piece of a ring)")
+
+
+#: How a tree joint of each kind is built, and a loop-closing one approximated.
+TREE_JOINTS = {"revolute": "hinge", "prismatic": "slide", "spherical": "ball",
+               "fixed": "child welded to its parent"}
+CLOSURES = {"revolute": "two connect equalities on the axis",
+            "spherical": "one connect equality", "fixed": "one weld equality"}
+
+
+def joint_capability(context: FeatureContext, kind: str) -> Capability | None:
+    """Support of an ideal joint kind; None for one the adapter does not know."""
+    if kind not in TREE_JOINTS:
+        return None
+    soft = sorted(name for name in context.closures if context.joint_kind[name] == kind)
+    if soft:
+        return _approx(f"tree {kind} joints exact; loop-closing ones ({', '.join(soft)}) "
+                       f"as {CLOSURES[kind]} (soft, drift)")
+    return _native(TREE_JOINTS[kind] + " in the tree: exact")

@@ -1,18 +1,19 @@
-"""The MuJoCo engine: a scene rebuilt in MuJoCo (see :mod:`.mujoco_build`), stepped with
-guards, and read out into the common :class:`~.trajectory.Trajectory`.
+"""The MuJoCo engine: a scene rebuilt in MuJoCo (see :mod:`.build`), stepped with guards
+(:mod:`.run`), and read out into the common :class:`~clearbench.adapters.trajectory.Trajectory`.
 
-Presets (each a separate engine variant ``mujoco[<preset>]``; see :mod:`.mujoco_settings`):
+Presets (each a separate engine variant ``mujoco[<preset>]``; see :mod:`.settings`):
 
 - ``default``: MuJoCo's own defaults (pyramidal cone, solref (0.02, 1), solimp
   (0.9, 0.95, 0.001), Euler, Newton, 100 iterations, no noslip);
 - ``tuned``: elliptic cone + 10 noslip iterations, solref (2 dt, 1), solimp
-  (0.99, 0.999, 1e-5) for contacts and loop closures, as ENGINES.md measured; plastic pairs
+  (0.99, 0.999, 1e-5) for contacts and loop closures (docs/engines/mujoco.md); plastic pairs
   (e = 0) mapped to dampratio 3 like every other restitution.
 
 Every pair with e > 0 gets dampratio zeta(e) of a unilateral spring-damper in both presets
-(MuJoCo has no restitution parameter; see :mod:`.mujoco_settings`).
+(MuJoCo has no restitution parameter; see :mod:`.settings`).
 
-``RunSettings.options`` override any field of :class:`~.mujoco_settings.MujocoSettings`.
+``RunSettings.options`` override any field of :class:`~.settings.MujocoSettings`; what each
+scene feature becomes: :mod:`.capabilities`.
 
 Units: MuJoCo's absolute defaults (solimp width 1 mm, collision tolerance 1e-6) assume metres
 and seconds, so a scene in other units is rescaled to SI for MuJoCo (``internal_units``) and
@@ -28,14 +29,13 @@ say energy may only decrease (``energy_non_increasing``, ``energy_conserved``).
 from __future__ import annotations
 
 import logging
-import math
 import time
 
-from clearbench.adapters.base import Capability, Engine, RunSettings
+from clearbench.adapters.base import ModuleEngine, RunSettings
+from clearbench.adapters.mujoco import capabilities
 from clearbench.adapters.mujoco.capabilities import (
     bore_summary,
     clearance_summary,
-    mujoco_capabilities,
     ring_summary,
 )
 from clearbench.adapters.mujoco.run import Runner
@@ -45,6 +45,7 @@ from clearbench.adapters.mujoco.settings import (
     MujocoSettings,
     resolve_settings,
 )
+from clearbench.adapters.recording import step_count
 from clearbench.adapters.trajectory import RunStatus, Trajectory
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.units import SI
@@ -57,7 +58,7 @@ __all__ = ["OPTION_NAMES", "PRESETS", "MujocoEngine", "availability", "create"]
 
 def availability() -> tuple[bool, str]:
     try:
-        import mujoco
+        import mujoco  # lazy import of the engine package: only when asked about it
     except ImportError as error:  # pragma: no cover - mujoco is a dependency
         return False, f"mujoco does not import: {error}"
     return True, f"mujoco {mujoco.__version__}"
@@ -67,24 +68,17 @@ def create(preset: str = "default") -> MujocoEngine:
     return MujocoEngine(preset)
 
 
-class MujocoEngine(Engine):
+class MujocoEngine(ModuleEngine):
     """MuJoCo (soft contacts, joint-coordinate trees) with a named preset."""
 
     name = "mujoco"
-
-    def __init__(self, preset: str = "default"):
-        if preset not in PRESETS:
-            raise ValueError(f"unknown mujoco preset {preset!r}; presets: {list(PRESETS)}")
-        self.preset = preset
-
-    def settings(self, options: dict | None = None) -> MujocoSettings:
-        """The preset overridden by ``options``."""
-        return resolve_settings(self.preset, options)
-
-    def capabilities(self, scene: Scene, options: dict | None = None) -> dict[str, Capability]:
-        return mujoco_capabilities(scene, self.settings(options))
+    PRESETS = PRESETS
+    OPTION_NAMES = OPTION_NAMES
+    CAPABILITIES = capabilities
+    RESOLVE_SETTINGS = staticmethod(resolve_settings)
 
     def _run(self, scene: Scene, settings: RunSettings) -> Trajectory:
+        # Lazy import of the optional engine package (mujoco) through the model builder.
         from clearbench.adapters.mujoco.build import build_model
 
         config = self.settings(settings.options)
@@ -94,30 +88,20 @@ class MujocoEngine(Engine):
         dt = (settings.time_step or scene.time_step) * to_internal
         horizon = (settings.horizon or scene.horizon) * to_internal
         built = build_model(internal, config, dt)
-        steps = int(math.ceil(horizon / dt - 1e-9))
-        record = list(range(0, steps + 1, settings.record_every))
-        if record[-1] != steps:
-            record.append(steps)
-        runner = Runner(internal, built, config, steps, len(record))
+        runner = Runner(internal, built, config, step_count(horizon, dt), settings.record_every)
         build_seconds = time.perf_counter() - start
-        status, message = _with_logged_warnings(runner, record)
-        trajectory = runner.trajectory(scene, internal)
-        trajectory.engine = self.name
-        trajectory.preset = self.preset
-        trajectory.build_seconds = build_seconds
-        trajectory.stepping_seconds = runner.stepping_seconds
-        trajectory.steps = runner.steps_taken
-        trajectory.status = status
-        trajectory.message = message
-        trajectory.metadata = _metadata(scene, internal, config, built, runner)
-        return trajectory
+        status, message = _with_logged_warnings(runner)
+        return runner.recorder.trajectory(
+            scene, runner.dt, recorded_units=internal.units, engine=self.name,
+            preset=self.preset, build_seconds=build_seconds,
+            stepping_seconds=runner.stepping_seconds, steps=runner.steps_taken, status=status,
+            message=message, metadata=_metadata(scene, internal, config, built, runner))
 
 
-def _with_logged_warnings(runner, record: list[int]) -> tuple[RunStatus, str]:
+def _with_logged_warnings(runner) -> tuple[RunStatus, str]:
     """Run with MuJoCo's text warnings sent to logging (instead of MUJOCO_LOG.TXT in the
     working directory) and kept for the metadata; the previous handler is restored."""
-    import mujoco
-
+    mujoco = runner.mujoco
     previous = mujoco.get_mju_user_warning()
 
     def handler(text: str) -> None:
@@ -127,7 +111,7 @@ def _with_logged_warnings(runner, record: list[int]) -> tuple[RunStatus, str]:
 
     mujoco.set_mju_user_warning(handler)
     try:
-        return runner.run(record)
+        return runner.run()
     finally:
         mujoco.set_mju_user_warning(previous)
 
@@ -139,8 +123,6 @@ def _internal_scene(scene: Scene, config: MujocoSettings) -> Scene:
 
 
 def _metadata(scene: Scene, internal: Scene, config: MujocoSettings, built, runner) -> dict:
-    import mujoco
-
     if internal.units != scene.units:
         units = (f"scene in {scene.units.describe()} rescaled to {internal.units.describe()} "
                  "for MuJoCo; results converted back")
@@ -148,7 +130,7 @@ def _metadata(scene: Scene, internal: Scene, config: MujocoSettings, built, runn
         units = f"run in the scene's units ({scene.units.describe()})"
     to_internal = scene.units.factor_to(internal.units, TIME)
     return {
-        "mujoco_version": mujoco.__version__,
+        "mujoco_version": runner.mujoco.__version__,
         "settings": config.as_dict(),
         "units": units,
         "time_step_internal": built.model.opt.timestep,

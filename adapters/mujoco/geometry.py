@@ -36,6 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from clearbench.adapters.mujoco.settings import MujocoSettings, ring_chord_error
+from clearbench.kernels.quaternion import quat_from_matrix, quat_normalize, quat_to_matrix
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.shapes import (
@@ -88,78 +89,6 @@ class RingInfo:
     chord_error: float
 
 
-def quat_multiply(p, q) -> np.ndarray:
-    """Hamilton product of (w, x, y, z) quaternions."""
-    w1, x1, y1, z1 = p
-    w2, x2, y2, z2 = q
-    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
-                     w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-                     w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
-
-
-def quat_to_matrix(q) -> np.ndarray:
-    """Rotation matrix (3, 3) of a (w, x, y, z) quaternion (normalised first)."""
-    w, x, y, z = np.asarray(q, dtype=float) / np.linalg.norm(q)
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
-
-
-def matrix_to_quat(matrix) -> np.ndarray:
-    """(w, x, y, z) quaternion with w >= 0 of a rotation matrix (Shepperd's method)."""
-    m = np.asarray(matrix, dtype=float)
-    trace = np.trace(m)
-    if trace > 0:
-        s = 2.0 * math.sqrt(1.0 + trace)
-        q = np.array([0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s,
-                      (m[1, 0] - m[0, 1]) / s])
-    else:
-        i = int(np.argmax(np.diag(m)))
-        j, k = (i + 1) % 3, (i + 2) % 3
-        s = 2.0 * math.sqrt(1.0 + m[i, i] - m[j, j] - m[k, k])
-        q = np.zeros(4)
-        q[0] = (m[k, j] - m[j, k]) / s
-        q[1 + i] = 0.25 * s
-        q[1 + j] = (m[j, i] + m[i, j]) / s
-        q[1 + k] = (m[k, i] + m[i, k]) / s
-    q /= np.linalg.norm(q)
-    return q if q[0] >= 0 else -q
-
-
-def scene_length_scale(scene: Scene) -> float:
-    """Largest characteristic length of the scene (shape sizes, body positions) [L]."""
-    lengths = [1e-300]
-    for body in scene.expanded.bodies:
-        lengths.append(float(np.linalg.norm(body.position)))
-        lengths.append(float(np.linalg.norm(body.center_of_mass)))
-        for shape in body.shapes:
-            lengths.append(float(np.linalg.norm(shape.position)))
-            for name in ("radius", "half_length"):
-                lengths.append(float(getattr(shape, name, 0.0)))
-            lengths += [float(x) for x in getattr(shape, "half_extents", ())]
-    return max(lengths)
-
-
-def smallest_feature_length(scene: Scene) -> float:
-    """Smallest positive clearance, offset or shape dimension [L] (the scale collision
-    tolerances must resolve)."""
-    lengths = []
-    for joint in scene.clearance_joints:
-        lengths += [joint.radial_clearance, joint.axial_clearance]
-    for contact in scene.all_contacts:
-        if contact.offset != 0:
-            lengths.append(abs(contact.offset))
-    for body in scene.expanded.bodies:
-        for shape in body.shapes:
-            for name in ("radius", "half_length"):
-                if hasattr(shape, name):
-                    lengths.append(getattr(shape, name))
-            lengths += list(getattr(shape, "half_extents", ()))
-    positive = [x for x in lengths if x > 0 and math.isfinite(x)]
-    return min(positive) if positive else scene_length_scale(scene)
-
-
 def ring_piece_radius(scene: Scene, body: str, shape: Shape, settings: MujocoSettings) -> float:
     """Piece radius of a ring: ``ring_piece_radius`` times its radius, at most half the radial
     clearance of the clearance joint it belongs to."""
@@ -175,8 +104,7 @@ def shape_geoms(scene: Scene, body_name: str, shape: Shape, settings: MujocoSett
     """Geoms standing in for ``shape`` of ``body_name`` (in the body frame)."""
     prefix = f"{body_name}/{shape.name}"
     position = np.asarray(shape.position, dtype=float)
-    orientation = np.asarray(shape.orientation, dtype=float)
-    orientation = orientation / np.linalg.norm(orientation)
+    orientation = quat_normalize(np.asarray(shape.orientation, dtype=float))
 
     def geom(kind, size, name=prefix, pos=position, quat=orientation, compensation=0.0,
              plane_compensation=0.0):
@@ -244,7 +172,7 @@ def _ring_geoms(scene: Scene, body_name: str, shape: Circle | Arc, settings: Muj
             # Piece axes: x radial, y = -ring axis, z along the chord (right-handed).
             local = np.column_stack([radial, [0.0, 0.0, -1.0], tangent])
             centre = position + rotation @ (apothem * radial)
-            quat = matrix_to_quat(rotation @ local)
+            quat = quat_from_matrix(rotation @ local)
             kind, size = ("capsule", (rho, half_chord)) if settings.ring_piece == "capsule" \
                 else ("box", (rho, rho, half_chord))
             out.append(geom(kind, size, name=f"{prefix}#{k}", pos=centre, quat=quat,
@@ -299,7 +227,7 @@ def _bore_geoms(body_name: str, shape: Bore, settings: MujocoSettings, geom, pos
         local = np.column_stack([radial, [0.0, 0.0, -1.0], tangent])
         centre = position + rotation @ ((shape.radius + wall) * radial)
         out.append(geom("box", (wall, shape.half_length, half_chord), name=f"{prefix}#{k}",
-                        pos=centre, quat=matrix_to_quat(rotation @ local)))
+                        pos=centre, quat=quat_from_matrix(rotation @ local)))
     return out, RingInfo(body_name, shape.name, shape.radius, pieces, wall,
                          bore_radius_error(shape, settings))
 

@@ -1,77 +1,45 @@
 """Law loads (angle and distance laws) in MuJoCo: evaluated by the reference solver's own force
 function from the MuJoCo state at the start of every step and applied through ``xfrc_applied``.
 
-One implementation of the laws: the scene's law loads are packed into force elements by the
-reference engine's :func:`~clearbench.adapters.reference.build.build_system` and evaluated by
-:func:`clearbench.ref_solver.forces.element_forces`, exactly as the reference engine does. The
-force acts at the start-of-step configuration during the whole step (explicit, one step lag).
-Law loads depend on the configuration only (angles, a distance), not on velocities.
+The evaluation is the shared one (:mod:`clearbench.adapters.force_elements`); this module maps
+it onto MuJoCo's bodies. The force acts at the start-of-step configuration during the whole
+step (explicit, one step lag). Law loads depend on the configuration only (angles, a
+distance), not on velocities.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from clearbench.ref_solver.forces import element_forces, no_angle_memory, remember_angles
+from clearbench.adapters.force_elements import (
+    ForceElements,
+    law_load_problems,
+    scene_force_elements,
+)
 from clearbench.ref_solver.system import FORCE_ANGLE_LAW, FORCE_DISTANCE_LAW
-from clearbench.scenarios.loads import AngleLawLoad, DistanceLawLoad
 from clearbench.scenarios.scene import Scene
+
+__all__ = ["LAW_KINDS", "LawForces", "law_forces", "law_load_problems"]
 
 LAW_KINDS = (FORCE_ANGLE_LAW, FORCE_DISTANCE_LAW)
 
 
-def law_load_problems(scene: Scene) -> list[tuple[str, str]]:
-    """(feature, reason) for every law load that cannot be evaluated (the reference's packing
-    takes angle laws of at most two bodies, applied to the law's own bodies); empty when all
-    can."""
-    out = []
-    for load in scene.loads:
-        if isinstance(load, AngleLawLoad):
-            feature, names = "angle_law_loads", load.angle_bodies
-            if len(names) > 2:
-                out.append((feature, f"{load.name}: angle law of {len(names)} bodies (the "
-                                     "shared law evaluation takes at most 2)"))
-        elif isinstance(load, DistanceLawLoad):
-            feature, names = "distance_law_loads", (load.body_a, load.body_b)
-        else:
-            continue
-        strangers = sorted({a.body for a in load.applications} - set(names))
-        if strangers:
-            out.append((feature, f"{load.name}: applied to {strangers}, not to bodies of its "
-                                 f"law {names} (the shared law evaluation cannot)"))
-    return out
-
-
 @dataclass
 class LawForces:
-    """The law loads of a scene as force elements of the reference solver.
+    """The law loads of a scene on the bodies of a MuJoCo model.
 
     Attributes
     ----------
-    kinds, body_a, body_b : (ne,) int arrays
-        Element kind and the two law bodies (indices into ``body_ids``).
-    parameters : (ne, 24) array
-        Element parameters (layout in :mod:`clearbench.ref_solver.forces`).
+    elements : ForceElements
+        The law loads as force elements (indices in scene body order).
     body_ids : (nb,) int array
         MuJoCo body id of each body of the scene (in ``scene.expanded.bodies`` order).
-    angle_memory : (ne, 2) array
-        The angle laws' continuous angles at the last :meth:`apply` (NaN: none yet; see
-        ``ref_solver.forces.remember_angles``), so that a body turning through the cut of its
-        raw angle does not make its law jump by k 2 pi.
     """
 
-    kinds: np.ndarray
-    body_a: np.ndarray
-    body_b: np.ndarray
-    parameters: np.ndarray
+    elements: ForceElements
     body_ids: np.ndarray
-    angle_memory: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
-
-    def __post_init__(self) -> None:
-        if self.angle_memory.shape != (self.kinds.shape[0], 2):
-            self.angle_memory = no_angle_memory(self.kinds.shape[0])
 
     def _pose(self, data) -> tuple[np.ndarray, np.ndarray]:
         """Centres of mass (nb, 3) and rotations (nb, 3, 3) of the scene's bodies in ``data``."""
@@ -82,41 +50,21 @@ class LawForces:
     def wrenches(self, data, time: float = 0.0) -> np.ndarray:
         """(nb, 6) force [F] and moment about the centre of mass [F L], both in world axes, of
         every body at the configuration in ``data`` (xipos and xmat must be current)."""
-        return self._wrenches(*self._pose(data), time)
-
-    def _wrenches(self, x: np.ndarray, rotation: np.ndarray, time: float) -> np.ndarray:
-        ids = self.body_ids
-        zeros = np.zeros_like(x)  # the laws read no velocity
-        out = np.zeros((len(ids), 6))
-        element_forces(time, x, rotation, zeros, zeros, self.kinds, self.body_a, self.body_b,
-                       self.parameters, self.angle_memory, False, out)
-        # element_forces gives moments in body axes; xfrc_applied wants world axes.
-        out[:, 3:] = np.einsum("bij,bj->bi", rotation, out[:, 3:])
-        return out
+        return self.elements.wrenches(time, *self._pose(data))
 
     def apply(self, data) -> None:
         """Add the law wrenches to ``data.xfrc_applied`` (applied at each centre of mass)."""
         x, rotation = self._pose(data)
-        np.add.at(data.xfrc_applied, self.body_ids, self._wrenches(x, rotation, float(data.time)))
-        remember_angles(rotation, self.kinds, self.body_a, self.body_b, self.parameters,
-                        self.angle_memory)
+        np.add.at(data.xfrc_applied, self.body_ids,
+                  self.elements.wrenches(float(data.time), x, rotation))
+        self.elements.remember(rotation)
 
 
 def law_forces(scene: Scene, model) -> LawForces | None:
     """Law loads of ``scene`` (the model's internal units) for the compiled ``model``; None
     when the scene has none. ValueError when :func:`law_load_problems` finds any."""
-    if not any(isinstance(load, AngleLawLoad | DistanceLawLoad) for load in scene.loads):
+    elements = scene_force_elements(scene, LAW_KINDS)
+    if elements is None:
         return None
-    problems = law_load_problems(scene)
-    if problems:
-        raise ValueError("law loads MuJoCo cannot apply: "
-                         + "; ".join(reason for _, reason in problems))
-    from clearbench.adapters.reference.build import build_system
-
-    system = build_system(scene)
-    keep = np.isin(system.force_kind, LAW_KINDS)
-    body_ids = np.array([model.body(name).id for name in system.body_names], dtype=np.int64)
-    return LawForces(np.ascontiguousarray(system.force_kind[keep]),
-                     np.ascontiguousarray(system.force_body_a[keep]),
-                     np.ascontiguousarray(system.force_body_b[keep]),
-                     np.ascontiguousarray(system.force_parameters[keep]), body_ids)
+    body_ids = np.array([model.body(name).id for name in elements.body_names], dtype=np.int64)
+    return LawForces(elements, body_ids)

@@ -1,7 +1,9 @@
-"""The step loop of a MuJoCo run: drivers, loads, guards, read-out into trajectory arrays.
+"""The step loop of a MuJoCo run: drivers, loads, guards, read-out into trajectory samples.
 
-Used by :mod:`.mujoco_engine`; works on a model built by :mod:`.mujoco_build`, in the model's
-internal units, and converts the samples back to the scene's units at the end.
+Used by :mod:`.engine`; works on a model built by :mod:`.build`, in the model's internal units,
+and records with :class:`~clearbench.adapters.recording.SampleRecorder` (the engine converts the
+samples back to the scene's units). Each sample's residual is MuJoCo's own for the recorded
+step; iterations and convergence are accumulated over the steps between samples.
 """
 
 from __future__ import annotations
@@ -12,73 +14,24 @@ import time
 
 import numpy as np
 
+from clearbench.adapters.energy_guard import EnergyGuard
 from clearbench.adapters.mujoco.settings import MujocoSettings
-from clearbench.adapters.trajectory import RunStatus, Trajectory
+from clearbench.adapters.recording import SampleRecorder
+from clearbench.adapters.trajectory import RunStatus
+from clearbench.kernels.time_profiles import evaluate_profile_slope
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.loads import LinearSpringDamper, Moment, PointForce, TorsionalSpringDamper
 from clearbench.scenarios.scene import Scene
-from clearbench.scenarios.validation import (
-    ANGULAR_VELOCITY,
-    FORCE,
-    LENGTH,
-    TIME,
-    VELOCITY,
-)
 
 logger = logging.getLogger(__name__)
-
-#: Expectation kinds under which the energy of the scene may not grow.
-ENERGY_EXPECTATIONS = ("energy_non_increasing", "energy_conserved")
-#: Features that do work the energy bookkeeping does not count (the guard stays off).
-WORK_FEATURES = ("drivers", "point_forces", "moments", "angle_law_loads", "distance_law_loads")
-
-
-def profile_integral(times, values, t) -> np.ndarray:
-    """Exact integral from 0 to ``t`` (T,) of the piecewise-linear profile (constant outside
-    its breakpoints; jumps where two breakpoints coincide)."""
-    knots = np.asarray(times, dtype=float)
-    levels = np.asarray(values, dtype=float)
-    t = np.asarray(t, dtype=float)
-
-    def antiderivative(x):
-        x = np.asarray(x, dtype=float)
-        if len(knots) == 1:
-            return levels[0] * (x - knots[0])
-        widths = np.diff(knots)
-        cumulative = np.concatenate(([0.0], np.cumsum(0.5 * (levels[:-1] + levels[1:])
-                                                      * widths)))
-        index = np.clip(np.searchsorted(knots, x, side="right") - 1, 0, len(knots) - 2)
-        width = widths[index]
-        slope = np.where(width > 0, (levels[index + 1] - levels[index])
-                         / np.where(width > 0, width, 1.0), 0.0)
-        offset = x - knots[index]
-        inside = cumulative[index] + levels[index] * offset + 0.5 * slope * offset**2
-        before = levels[0] * (x - knots[0])
-        after = cumulative[-1] + levels[-1] * (x - knots[-1])
-        return np.where(x < knots[0], before, np.where(x >= knots[-1], after, inside))
-
-    return antiderivative(t) - antiderivative(0.0)
-
-
-def profile_slope(times, values, t) -> np.ndarray:
-    """Right derivative of the piecewise-linear profile at ``t`` (T,)."""
-    knots = np.asarray(times, dtype=float)
-    levels = np.asarray(values, dtype=float)
-    t = np.asarray(t, dtype=float)
-    if len(knots) == 1:
-        return np.zeros_like(t)
-    index = np.clip(np.searchsorted(knots, t, side="right") - 1, 0, len(knots) - 2)
-    width = knots[index + 1] - knots[index]
-    slope = np.where(width > 0, (levels[index + 1] - levels[index])
-                     / np.where(width > 0, width, 1.0), 0.0)
-    return np.where((t < knots[0]) | (t >= knots[-1]), 0.0, slope)
 
 
 class Runner:
     """The step loop of one run: drivers, loads, guards, and sampling into arrays."""
 
-    def __init__(self, scene: Scene, built, config: MujocoSettings, steps: int, samples: int):
-        import mujoco
+    def __init__(self, scene: Scene, built, config: MujocoSettings, steps: int,
+                 record_every: int):
+        import mujoco  # lazy import of the engine package (the adapter imports without it)
 
         self.mujoco = mujoco
         self.scene = scene
@@ -88,87 +41,40 @@ class Runner:
         self.model, self.data = built.model, built.data
         model = self.model
         self.dt = model.opt.timestep
-        nb = len(scene.bodies)
-        npair = len(scene.all_contacts)
+        self.recorder = SampleRecorder(len(scene.bodies), len(scene.all_contacts), steps,
+                                       record_every)
         self.ids = built.body_ids
         self.movable = np.array([b.motion is not Motion.FIXED for b in scene.bodies])
         self.mass = np.array([b.mass for b in scene.bodies])
         self.inertia = np.array([np.asarray(b.inertia, dtype=float) for b in scene.bodies])
         self.gravity = np.asarray(scene.gravity, dtype=float)
-        self.times = np.zeros(samples)
-        self.positions = np.zeros((samples, nb, 3))
-        self.orientations = np.zeros((samples, nb, 4))
-        self.velocities = np.zeros((samples, nb, 3))
-        self.omegas = np.zeros((samples, nb, 3))
-        self.normal = np.zeros((samples, npair))
-        self.force = np.zeros((samples, npair, 3))
-        self.iterations = np.zeros(samples, dtype=np.int64)
-        self.residual = np.full(samples, np.nan)
-        self.converged = np.ones(samples, dtype=bool)
-        self.active = np.zeros(samples, dtype=np.int64)
-        self.count = 0
         self.stepping_seconds = 0.0
         self.steps_taken = 0
         self.unconverged: list[int] = []
         self.warnings: list[str] = []
-        self.guard_notes: list[str] = []
         self.mujoco_warnings: dict[str, int] = {}
         self.max_contacts = 0
-        self.energy_initial = float("nan")
-        self.energy_max_gain = 0.0
-        self._kinetic_max = 0.0
-        self._iterations = 0
-        self._residual = 0.0
-        self._converged = True
         self._springs = [load for load in scene.loads if isinstance(load, LinearSpringDamper)]
         self._site_ids = [(model.site(f"{s.name}:a").id, model.site(f"{s.name}:b").id)
                           for s in self._springs]
         self._hinge_springs = built.hinge_springs
-        self._energy_guard = self._energy_guard_applies()
-        self._size_energy = self._size_energy_scale()
+        self.guard = EnergyGuard(scene, config.energy_gain_tolerance, config.guard_interval)
+        self.guard_notes = self.guard.notes
         step_times = np.arange(steps + 1) * self.dt
         self._drive = []
         for dof in built.driven:
             driver = dof.driver
+            position = np.asarray(driver.displacement(step_times), dtype=float)
+            velocity = np.asarray(driver.velocity(step_times), dtype=float)
             if driver.quantity == "position":
-                position = np.asarray(driver.displacement(step_times), dtype=float)
-                velocity = np.asarray(driver.velocity(step_times), dtype=float)
                 acceleration = np.zeros_like(step_times)
             else:
-                position = profile_integral(driver.times, driver.values, step_times)
-                velocity = np.asarray(driver.velocity(step_times), dtype=float)
-                acceleration = profile_slope(driver.times, driver.values, step_times)
+                acceleration = evaluate_profile_slope(driver.times, driver.values, step_times)
             armature = model.dof_armature[dof.dof_address]
             self._drive.append((dof, dof.initial + dof.sign * position, dof.sign * velocity,
                                 armature * dof.sign * acceleration))
 
     # ------------------------------------------------------------------ guards
-    def _energy_guard_applies(self) -> bool:
-        kinds = {e.kind for e in self.scene.expectations}
-        if not kinds & set(ENERGY_EXPECTATIONS):
-            self.guard_notes.append("energy guard off: no energy expectation")
-            return False
-        work = sorted(set(WORK_FEATURES) & self.scene.features)
-        if work:
-            self.guard_notes.append(f"energy guard off: {', '.join(work)} do uncounted work")
-            return False
-        self.guard_notes.append(
-            f"energy guard on: stops when energy exceeds its initial value by more than "
-            f"{self.config.energy_gain_tolerance:g} x the energy scale (largest kinetic energy "
-            f"so far, at least sum(m |g|) x largest shape size), checked every "
-            f"{self.config.guard_interval} steps and at every sample")
-        return True
-
-    def _size_energy_scale(self) -> float:
-        size = 0.0
-        for body in self.scene.expanded.bodies:
-            for shape in body.shapes:
-                values = [getattr(shape, "radius", 0.0), getattr(shape, "half_length", 0.0)]
-                values += list(getattr(shape, "half_extents", ()))
-                size = max(size, *values)
-        g = float(np.linalg.norm(self.gravity))
-        return float(np.sum(self.mass[self.movable])) * g * size
-
     def _check_warnings(self) -> str | None:
         counts = self.data.warning.number
         if not counts.any():
@@ -231,17 +137,15 @@ class Runner:
         return float(kinetic + potential + springs), float(kinetic)
 
     def check_energy(self) -> str | None:
-        total, kinetic = self.energy()
-        self._kinetic_max = max(self._kinetic_max, kinetic)
-        gain = total - self.energy_initial
-        scale = max(self._kinetic_max, self._size_energy, 1e-300)
-        self.energy_max_gain = max(self.energy_max_gain, gain / scale)
-        if gain > self.config.energy_gain_tolerance * scale:
-            return (f"energy gain {gain:.4g} (internal units) = {gain / scale:.3g} x the energy "
-                    f"scale at t = {self.data.time:.6g}: above the tolerance "
-                    f"{self.config.energy_gain_tolerance:g} on a scene whose energy may only "
-                    "decrease")
-        return None
+        return self.guard.check(*self.energy(), self.data.time)
+
+    @property
+    def energy_initial(self) -> float:
+        return self.guard.energy_initial
+
+    @property
+    def energy_max_gain(self) -> float:
+        return self.guard.max_gain
 
     # ------------------------------------------------------------------ loads
     def apply_loads(self) -> None:
@@ -290,15 +194,14 @@ class Runner:
             d.xfrc_applied[a_id, 3:] -= moment
 
     # ------------------------------------------------------------------ loop
-    def run(self, record: list[int]) -> tuple[RunStatus, str]:
+    def run(self) -> tuple[RunStatus, str]:
+        """Step the run, sampling into :attr:`recorder`; (status, message) of its end."""
         mj = self.mujoco
         model, data = self.model, self.data
+        recorder = self.recorder
         self.refresh_kinematics()
-        self.store(0)
-        self.energy_initial, kinetic = self.energy()
-        self._kinetic_max = kinetic
-        next_record = 1
-        interval = self.config.guard_interval
+        self.store()
+        self.guard.start(*self.energy())
         iterations_cap = model.opt.iterations
         for k in range(1, self.steps + 1):
             tick = time.perf_counter()
@@ -313,36 +216,31 @@ class Runner:
             self.steps_taken = k
             islands = min(max(int(data.nisland), 1), len(data.solver_niter))
             niter = int(data.solver_niter[:islands].max())
-            self._iterations += niter
+            recorder.accumulate(niter, converged=niter < iterations_cap)
             if niter >= iterations_cap:
-                self._converged = False
                 self.unconverged.append(k)
             self.max_contacts = max(self.max_contacts, int(data.ncon))
             problem = self._check_warnings()
             if problem is None and not (np.isfinite(data.qpos).all()
                                         and np.isfinite(data.qvel).all()):
                 problem = f"non-finite state at step {k} (t = {data.time:.6g})"
-            recording = next_record < len(record) and k == record[next_record]
-            checking = self._energy_guard and k % interval == 0
+            recording = recorder.is_due(k)
+            checking = self.guard.due(k)
             if problem is None and (recording or checking):
                 forces = self.contact_forces() if recording else None
                 self.refresh_kinematics()
-                if self._energy_guard:
+                if self.guard.applies:
                     problem = self.check_energy()
                 if recording:
-                    self.store(next_record, forces)
-                    next_record += 1
-            elif problem is not None and next_record < len(record):
+                    self.store(forces)
+            elif problem is not None and not recorder.is_full:
                 # Keep the offending state as the last sample.
                 forces = self.contact_forces()
                 self.refresh_kinematics()
-                self.store(next_record, forces)
-                next_record += 1
+                self.store(forces)
             if problem is not None:
-                self.count = next_record
                 logger.info("%s: stopped: %s", self.scene.name, problem)
                 return RunStatus.DIVERGED, problem
-        self.count = next_record
         return RunStatus.OK, ""
 
     # ------------------------------------------------------------------ read-out
@@ -351,7 +249,7 @@ class Runner:
         (npair, 3), from the constraint forces of the step just taken; and active contacts."""
         mj = self.mujoco
         model, data = self.model, self.data
-        npair = self.normal.shape[1]
+        npair = len(self.scene.all_contacts)
         normal = np.zeros(npair)
         total = np.zeros((npair, 3))
         active = 0
@@ -388,39 +286,10 @@ class Runner:
                 worst = max(worst, float(stat.gradient))
         return worst
 
-    def store(self, i: int, forces=None) -> None:
+    def store(self, forces: tuple | None = None) -> None:
+        """Record the current state as the next sample; with ``forces`` (from
+        :meth:`contact_forces`), the step's solver statistics and own residual too."""
         position, orientation, velocity, omega = self.body_state()
-        self.times[i] = self.data.time
-        self.positions[i] = position
-        self.orientations[i] = orientation
-        self.velocities[i] = velocity
-        self.omegas[i] = omega
-        if forces is not None:
-            self.normal[i], self.force[i], self.active[i] = forces
-            self.iterations[i] = self._iterations
-            self.residual[i] = self.solver_residual()
-            self.converged[i] = self._converged
-            self._iterations, self._converged = 0, True
-
-    def trajectory(self, scene: Scene, internal: Scene) -> Trajectory:
-        """Samples converted back to the scene's units."""
-        n = self.count
-        back = internal.units
-
-        def factor(dimension):
-            return back.factor_to(scene.units, dimension)
-
-        return Trajectory(
-            engine="", preset="", scene_name=scene.name, scene_hash=scene.content_hash,
-            units={"length": scene.units.length, "mass": scene.units.mass,
-                   "time": scene.units.time},
-            time_step=self.dt * factor(TIME), body_names=tuple(b.name for b in scene.bodies),
-            contact_names=tuple(c.name for c in scene.all_contacts),
-            times=self.times[:n] * factor(TIME), positions=self.positions[:n] * factor(LENGTH),
-            orientations=self.orientations[:n], velocities=self.velocities[:n] * factor(VELOCITY),
-            angular_velocities=self.omegas[:n] * factor(ANGULAR_VELOCITY),
-            contact_normal_force=self.normal[:n] * factor(FORCE),
-            contact_force=self.force[:n] * factor(FORCE),
-            solver_iterations=self.iterations[:n], solver_residual=self.residual[:n],
-            solver_converged=self.converged[:n], active_contacts=self.active[:n],
-        )
+        residual = self.solver_residual() if forces is not None else None
+        self.recorder.store(self.data.time, position, orientation, velocity, omega,
+                            contacts=forces, residual=residual)

@@ -29,27 +29,20 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass
 
-import numpy as np
-
+from clearbench.adapters.joint_tree import (
+    DrivenDof,
+    axis_sign,
+    rotations_held,
+    split_joint_graph,
+)
 from clearbench.scenarios.bodies import Motion
-from clearbench.scenarios.drivers import Driver
 from clearbench.scenarios.scene import Scene
 
-#: Preference of a joint kind as a tree edge (lower first).
-TREE_PRIORITY = {"prismatic": 0, "revolute": 1, "spherical": 2, "fixed": 3}
+__all__ = ["TREE_JOINT", "DrivenDof", "Topology", "TreeLink", "plan_topology",
+           "rotations_held"]
+
 #: MuJoCo tree joint realising each scene joint kind (None: child welded to its parent).
 TREE_JOINT = {"revolute": "hinge", "prismatic": "slide", "spherical": "ball", "fixed": None}
-AXIS_TOLERANCE = 1e-9  # |1 - |a . b|| below which a joint axis is a world axis
-
-
-@dataclass(frozen=True)
-class DrivenDof:
-    """A driven degree of freedom: ``joint`` of the MuJoCo body moves as ``sign`` times the
-    driver's displacement / velocity."""
-
-    driver: Driver
-    joint: str          # 'tree' (the body's tree hinge/slide) or 'slide_x' / 'slide_y' / ...
-    sign: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -93,43 +86,12 @@ class Topology:
 
 def plan_topology(scene: Scene) -> Topology:
     """Split the joint graph of ``scene`` into a MuJoCo tree and loop closures."""
-    fixed = {b.name for b in scene.bodies if b.motion is Motion.FIXED}
-    parent: dict[str, str] = {}
-
-    def node(name: str) -> str:
-        return "<fixed>" if name in fixed else name
-
-    def root(name: str) -> str:
-        while parent.get(name, name) != name:
-            name = parent[name]
-        return name
-
-    ignored = []
-    tree_edges, closures = [], []
-    order = sorted(range(len(scene.joints)),
-                   key=lambda i: (TREE_PRIORITY[scene.joints[i].kind], i))
-    for i in order:
-        joint = scene.joints[i]
-        if joint.body_a in fixed and joint.body_b in fixed:
-            ignored.append(joint.name)
-            continue
-        a, b = root(node(joint.body_a)), root(node(joint.body_b))
-        if a == b:
-            closures.append(joint)
-        else:
-            parent[a] = b
-            tree_edges.append(joint)
-    adjacency: dict[str, list] = {b.name: [] for b in scene.bodies}
-    for joint in tree_edges:
-        adjacency[joint.body_a].append((joint, joint.body_b))
-        adjacency[joint.body_b].append((joint, joint.body_a))
-
+    graph = split_joint_graph(scene)
+    fixed, adjacency, drivers_of = graph.fixed, graph.adjacency, graph.drivers_of
+    closures = graph.closures
     links: list[TreeLink] = []
     visited: set[str] = set()
     queue: deque[str] = deque()
-    drivers_of: dict[str, list] = {}
-    for driver in scene.drivers:
-        drivers_of.setdefault(driver.body, []).append(driver)
 
     def visit_from(start: str) -> None:
         queue.append(start)
@@ -171,14 +133,7 @@ def plan_topology(scene: Scene) -> Topology:
     driven, driver_problems = _plan_drivers(scene, links, fixed, drivers_of)
     problems += driver_problems
     return Topology(tuple(links), tuple(j.name for j in closures), driven, tuple(problems),
-                    tuple(ignored))
-
-
-def rotations_held(rotations: list[Driver]) -> bool:
-    """True when the three rotation components are all driven and each profile is zero
-    throughout (the body keeps its initial orientation)."""
-    return len({d.component for d in rotations}) == 3 and all(
-        not any(d.values) for d in rotations)
+                    graph.ignored)
 
 
 def _plan_drivers(scene: Scene, links: list, fixed: set, drivers_of: dict):
@@ -195,16 +150,9 @@ def _plan_drivers(scene: Scene, links: list, fixed: set, drivers_of: dict):
                                  if not d.is_rotation)
             continue
         if link.kind in ("hinge", "slide") and link.parent in fixed and len(drivers) == 1:
-            driver = drivers[0]
-            joint = joints[link.joint]
-            axis = np.asarray(joint.axis, dtype=float)
-            world = np.eye(3)[driver.axis_index]
-            alignment = float(axis @ world)
-            wanted = "hinge" if driver.is_rotation else "slide"
-            if link.kind == wanted and abs(abs(alignment) - 1.0) < AXIS_TOLERANCE:
-                # A joint is stated in body_a -> body_b terms; the tree child moves relative to
-                # the fixed parent, so the sign follows the axis alignment only.
-                driven[body] = (DrivenDof(driver, "tree", float(np.sign(alignment))),)
+            sign = axis_sign(joints[link.joint], drivers[0])
+            if sign is not None:
+                driven[body] = (DrivenDof(drivers[0], "tree", sign),)
                 continue
         problems.append((
             "drivers",

@@ -1,5 +1,5 @@
 """The reference engine: our nonsmooth Moreau--Jean solver behind the Engine contract."""
 
-from clearbench.adapters.reference.engine import OPTION_NAMES, PRESETS, availability, create
+from clearbench.adapters.reference.engine import ReferenceEngine, availability, create
 
-__all__ = ["OPTION_NAMES", "PRESETS", "availability", "create"]
+__all__ = ["ReferenceEngine", "availability", "create"]

@@ -3,7 +3,7 @@ nonsmooth engine.
 
 Siconos imports only under /usr/bin/python3 with Debian's numpy and a clean environment, so
 every run goes through a worker process (:mod:`.worker.engine`, started by
-:func:`~.siconos_process.run_worker`): this side sends the scene (JSON, clearance joints
+:func:`~.process.run_worker`): this side sends the scene (JSON, clearance joints
 expanded) and the settings, the worker builds the model with the kernel API and returns the
 common trajectory as .npz. A crash or a hang of the worker is a recorded outcome (CRASHED /
 TIMED_OUT), never an exception.
@@ -36,7 +36,7 @@ loads are explicit forces (no stiffness Jacobian); rotation drivers prescribe th
 angular velocity aligned with the driven world axis at t = 0; position drivers are imposed
 through their rate.
 Unsupported: box-box and capsule-capsule pairs (their candidate count changes with the
-configuration; see :mod:`worker_geometry`), and any feature the adapter does not know.
+configuration; see :mod:`.worker.geometry`), and any feature the adapter does not know.
 """
 
 from __future__ import annotations
@@ -49,16 +49,16 @@ from pathlib import Path
 import numpy as np
 
 from clearbench.adapters.base import Capability, Engine, RunSettings, Support
-from clearbench.adapters.reference.build import feature_lengths
 from clearbench.adapters.siconos.process import (
     SICONOS_PYTHON,
     WorkerStatus,
-    clean_environment,
+    interpreter_imports,
     run_worker,
 )
 from clearbench.adapters.siconos.worker import geometry as worker_geometry
-from clearbench.adapters.trajectory import RunStatus, Trajectory
+from clearbench.adapters.trajectory import RunStatus, Trajectory, scene_fields
 from clearbench.kernels.quaternion import quat_normalize, quat_to_matrix
+from clearbench.scenarios.scales import feature_lengths
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.serialization import scene_to_json
 
@@ -146,19 +146,10 @@ def _pair_capability(kind_a: str, kind_b: str, projection: bool = False) -> Capa
 @functools.cache
 def availability() -> tuple[bool, str]:
     """Whether Debian's interpreter imports the Siconos kernel and joints (never raises)."""
-    if not Path(SICONOS_PYTHON).exists():
-        return False, f"Siconos unavailable: {SICONOS_PYTHON} not found"
-    try:
-        completed = subprocess.run(
-            [SICONOS_PYTHON, "-c",
-             "import siconos.kernel, siconos.mechanics.joints, siconos.numerics"],
-            env=clean_environment(), capture_output=True, text=True, timeout=120)
-    except (OSError, subprocess.TimeoutExpired) as error:
-        return False, f"Siconos unavailable: {error}"
-    if completed.returncode != 0:
-        last = (completed.stderr.strip().splitlines() or ["import failed"])[-1]
-        return False, (f"Siconos unavailable ({last}); install Debian's python3-siconos "
-                       "(`make siconos` as root)")
+    available, why = interpreter_imports(
+        "siconos.kernel, siconos.mechanics.joints, siconos.numerics")
+    if not available:
+        return False, why
     try:
         version = subprocess.run(
             ["dpkg-query", "-W", "-f=${Version}", "python3-siconos"],
@@ -176,51 +167,44 @@ class SiconosEngine(Engine):
     """Siconos 4.4 kernel (Moreau-Jean, fc3d / GenericMechanical) in a worker process."""
 
     name = "siconos"
-
-    def __init__(self, preset: str = "default"):
-        if preset not in PRESETS:
-            raise ValueError(f"unknown siconos preset {preset!r}; presets: {list(PRESETS)}")
-        self.preset = preset
+    PRESETS = PRESETS
+    OPTION_NAMES = OPTION_NAMES
 
     # ------------------------------------------------------------------ capabilities
-    def capabilities(self, scene: Scene) -> dict[str, Capability]:
-        """Support of every scene feature; a feature this adapter does not know is UNSUPPORTED
-        (it must never claim what it does not do)."""
-        out = {}
-        for feature in scene.features:
-            if feature.startswith("pair:"):
-                a, b = feature[5:].split("-")
-                out[feature] = _pair_capability(a, b, bool(PRESETS[self.preset]["projection"]))
-            elif feature.startswith("shape:"):
-                kind = feature[6:]
-                out[feature] = Capability(Support.NATIVE, "shared closed-form geometry") \
-                    if kind in worker_geometry.SHAPE_KINDS else \
-                    Capability(Support.UNSUPPORTED, f"no worker geometry for shape {kind!r}")
-            elif feature.startswith("joint:"):
-                kind = feature[6:]
-                out[feature] = Capability(
-                    Support.NATIVE, f"{_JOINT_CLASSES[kind]} + EqualityConditionNSL") \
-                    if kind in _JOINT_CLASSES else \
-                    Capability(Support.UNSUPPORTED, f"no Siconos joint for {kind!r}")
-            elif feature in _EXPLICIT_FORCES:
-                out[feature] = Capability(
-                    Support.APPROXIMATED, _EXPLICIT_FORCES[feature] + " from the current "
-                    "iterate in computeFExt / computeMExt, theta-weighted by Moreau-Jean "
-                    "without a stiffness Jacobian: stable only for h < 2 / omega of the "
-                    "stiffest spring")
-            elif feature == "drivers":
-                out[feature] = self._driver_capability(scene)
-            elif feature == "ideal_joints":
-                out[feature] = Capability(
-                    Support.NATIVE, "Siconos joint relations at velocity level; position drift "
-                    "corrected only by the projection preset")
-            elif feature in _NATIVE_FEATURES:
-                out[feature] = Capability(Support.NATIVE, _NATIVE_FEATURES[feature])
-            else:
-                out[feature] = Capability(
-                    Support.UNSUPPORTED, f"the Siconos adapter does not know feature "
-                    f"{feature!r}")
-        return out
+    def plain_capability(self, context, name: str) -> Capability | None:
+        if name in _EXPLICIT_FORCES:
+            return Capability(
+                Support.APPROXIMATED, _EXPLICIT_FORCES[name] + " from the current "
+                "iterate in computeFExt / computeMExt, theta-weighted by Moreau-Jean "
+                "without a stiffness Jacobian: stable only for h < 2 / omega of the "
+                "stiffest spring")
+        if name == "drivers":
+            return self._driver_capability(context.scene)
+        if name == "ideal_joints":
+            return Capability(
+                Support.NATIVE, "Siconos joint relations at velocity level; position drift "
+                "corrected only by the projection preset")
+        if name in _NATIVE_FEATURES:
+            return Capability(Support.NATIVE, _NATIVE_FEATURES[name])
+        return None
+
+    def shape_capability(self, context, kind: str) -> Capability | None:
+        if kind in worker_geometry.SHAPE_KINDS:
+            return Capability(Support.NATIVE, "shared closed-form geometry")
+        return None
+
+    def joint_capability(self, context, kind: str) -> Capability | None:
+        if kind in _JOINT_CLASSES:
+            return Capability(Support.NATIVE, f"{_JOINT_CLASSES[kind]} + EqualityConditionNSL")
+        return None
+
+    def pair_capability(self, context, kind_a: str, kind_b: str) -> Capability | None:
+        known = worker_geometry.SHAPE_KINDS
+        if kind_a not in known or kind_b not in known:
+            return None
+        # The preset's projection, or the run option's.
+        projection = bool({**PRESETS[self.preset], **context.options}["projection"])
+        return _pair_capability(kind_a, kind_b, projection)
 
     @staticmethod
     def _driver_capability(scene: Scene) -> Capability:
@@ -250,15 +234,13 @@ class SiconosEngine(Engine):
     # ------------------------------------------------------------------ settings
     def resolved_options(self, scene: Scene, settings: RunSettings) -> dict:
         """Preset + defaults + ``settings.options``, checked."""
-        unknown = sorted(set(settings.options) - set(OPTION_NAMES))
-        if unknown:
-            raise ValueError(f"unknown siconos options {unknown}; options: {OPTION_NAMES}")
+        self.check_options(settings.options)
         options = dict(DEFAULTS)
         options.update(PRESETS[self.preset])
         options.update(settings.options)
         lengths = feature_lengths(scene)
         smallest = min(lengths) if lengths else 1.0
-        # 1e-8 of the smallest feature (ENGINES.md: about 1e-8 in model units works): far
+        # 1e-8 of the smallest feature (docs/engines/siconos.md: about 1e-8 works): far
         # below what the metrics resolve, far enough above round-off that the projection loop
         # terminates.
         options.setdefault("constraint_tolerance", 1e-8 * smallest)
@@ -288,14 +270,6 @@ class SiconosEngine(Engine):
         options = self.resolved_options(scene, settings)
         h = settings.time_step or scene.time_step
         horizon = settings.horizon or scene.horizon
-        if options["projection"]:  # the preset may not have it, an option may switch it on
-            dropping = sorted(f for f in scene.features if f.startswith("pair:")
-                              and worker_geometry.drops_candidates(*f[5:].split("-")))
-            if dropping:
-                return Trajectory.empty(
-                    self.name, self.preset, scene, RunStatus.UNSUPPORTED,
-                    f"{', '.join(dropping)} with projection: {PROJECTION_DROPPED_SLOTS}", h,
-                    {"projection": True})
         worker_settings = {key: options[key] for key in options if key != "timeout"}
         worker_settings.update(time_step=h, horizon=horizon, record_every=settings.record_every)
         inputs = {"scene_json": np.array(scene_to_json(scene.expanded, indent=None)),
@@ -332,12 +306,7 @@ class SiconosEngine(Engine):
                      "contact_normal_force", "contact_force", "solver_residual"):
             arrays[name] = arrays[name].astype(np.float64)
         return Trajectory(
-            engine=self.name, preset=self.preset, scene_name=scene.name,
-            scene_hash=scene.content_hash,
-            units={"length": scene.units.length, "mass": scene.units.mass,
-                   "time": scene.units.time},
-            time_step=h, body_names=tuple(b.name for b in scene.bodies),
-            contact_names=tuple(c.name for c in scene.all_contacts), **arrays,
+            engine=self.name, preset=self.preset, **scene_fields(scene), time_step=h, **arrays,
             build_seconds=float(data["build_seconds"]),
             stepping_seconds=float(data["stepping_seconds"]), steps=int(data["steps"]),
             status=status, message=str(data["message"]), metadata=metadata,

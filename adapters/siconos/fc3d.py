@@ -1,7 +1,7 @@
 """Siconos's fc3d solvers (NSGS with Alart–Curnier local Newton, NSN-AC) on a ContactProblem.
 
 Parent side of :mod:`.worker.fc3d`; everything runs in a separate Debian Python process
-(see :mod:`siconos_process`). Used to validate our solvers side by side with Siconos.
+(see :mod:`.process`). Used to validate our solvers side by side with Siconos.
 """
 
 from __future__ import annotations

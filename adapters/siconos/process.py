@@ -58,14 +58,15 @@ def clean_environment() -> dict[str, str]:
     return env
 
 
-@functools.cache
-def siconos_availability() -> tuple[bool, str]:
-    """(available, message): whether ``import siconos.numerics`` works under SICONOS_PYTHON."""
+def interpreter_imports(modules: str) -> tuple[bool, str]:
+    """(True, "") when :data:`SICONOS_PYTHON` imports ``modules`` (``import`` syntax, e.g.
+    ``"siconos.kernel, siconos.numerics"``) in the clean environment, else (False, why);
+    never raises."""
     if not Path(SICONOS_PYTHON).exists():
         return False, f"Siconos unavailable: {SICONOS_PYTHON} not found"
     try:
         completed = subprocess.run(
-            [SICONOS_PYTHON, "-c", "import siconos.numerics"], env=clean_environment(),
+            [SICONOS_PYTHON, "-c", f"import {modules}"], env=clean_environment(),
             capture_output=True, text=True, timeout=120,
         )
     except (OSError, subprocess.TimeoutExpired) as error:
@@ -74,7 +75,14 @@ def siconos_availability() -> tuple[bool, str]:
         last = (completed.stderr.strip().splitlines() or ["import failed"])[-1]
         return False, (f"Siconos unavailable ({last}); install Debian's python3-siconos "
                        "(`make siconos` as root)")
-    return True, "Siconos available"
+    return True, ""
+
+
+@functools.cache
+def siconos_availability() -> tuple[bool, str]:
+    """(available, message): whether ``import siconos.numerics`` works under SICONOS_PYTHON."""
+    available, why = interpreter_imports("siconos.numerics")
+    return (True, "Siconos available") if available else (False, why)
 
 
 def siconos_available() -> bool:

@@ -9,6 +9,7 @@ trajectory file keyed by the scene's content hash), computes the figures and ret
 from __future__ import annotations
 
 import functools
+import json
 import logging
 import math
 import time
@@ -19,10 +20,12 @@ import numpy as np
 
 import clearbench
 from clearbench.adapters.base import RunSettings
-from clearbench.adapters.reference.engine import create
+from clearbench.adapters.reference import create
 from clearbench.adapters.trajectory import Trajectory
 from clearbench.harness.c60 import analysis
 from clearbench.harness.measure import series as metrics
+from clearbench.kernels.quaternion import quat_to_matrix
+from clearbench.ref_solver.forces import twist_angle
 from clearbench.scenarios.c60 import model
 from clearbench.scenarios.library import get_scene
 from clearbench.scenarios.scene import Scene
@@ -336,9 +339,6 @@ def _first_contact_phase(run: Run) -> str:
 def explain_contact_force(run: Run) -> str:
     """Why FC-1 is what it is: the moving contact's moment balance about the needle, with the
     figures of the run's last sample."""
-    from clearbench.kernels.quaternion import quat_to_matrix
-    from clearbench.ref_solver.forces import twist_angle
-
     scene, trajectory = run.scene, run.trajectory
     z = np.array([0.0, 0.0, 1.0])
     law = next(load for load in scene.loads if load.name == "contact_pressure_spring")
@@ -399,7 +399,7 @@ MODEL_NOTES = (
     "Angle laws take each body's angle about the law's axis as the source's 2 acos(q_w) "
     "does, but continuous: a body turning through the cut of the raw angle (pi) keeps its law "
     "continuous (the source's would jump by k 2 pi; in the ON and trip runs no law body comes "
-    "near the cut). `benchmarks/c60_body_angles.py TRAJECTORY.npz` prints each body's raw "
+    "near the cut). `clearbench c60 angles TRAJECTORY.npz` prints each body's raw "
     "angle and the largest body speed along a run (the runs are cached in .cache/c60/).",
     "Bounded faces: TRIP_1 and C3 ON 1, 2 have their nearest point beyond the face (no "
     "contact candidate; OpenCASCADE measures to the face's edge, 0.86 and 3.8 mm in the ON "
@@ -518,8 +518,6 @@ def write_json(report: ValidationReport, path: Path, figures: dict[str, Path],
     """The table, findings, runs and figure files as JSON, for the comparison report
     (:mod:`clearbench.harness.report.page` shows it as its C-60 section). Figure paths are
     relative to ``path``'s directory; NaN (no published figure) is null."""
-    import json
-
     base = path.parent.resolve()
     document = {
         "title": "C-60: the reference engine against the published figures",
@@ -553,7 +551,7 @@ def write_json(report: ValidationReport, path: Path, figures: dict[str, Path],
 
 def write_figures(report: ValidationReport, directory: Path) -> dict[str, Path]:
     """Force-displacement figures of the bench tests (PNG), with the paper's key points."""
-    import matplotlib
+    import matplotlib  # lazy: matplotlib is loaded only when a figure is drawn
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

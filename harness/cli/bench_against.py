@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import argparse
 
-from clearbench.harness.cli.main import UserError
+from clearbench.harness.cli.common import UserError
+from clearbench.harness.studies.against import Case, resolve, side_by_side
 
 #: Cases of each benchmark that supports ``--against``: (scene, factory parameters, horizon
 #: [scene time unit; None: the scene's]); every preset of ``--presets`` runs each.
@@ -17,7 +18,7 @@ DEFAULT_PRESETS = {"c60": ("default", "newton"), "reference": ("default",)}
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The options of ``--against`` on the ``bench`` parser."""
+    """The options of ``--against`` on the parser of a benchmark that supports it."""
     parser.add_argument("--against", metavar="REV",
                         help="c60, reference: also run the baseline git revision REV, "
                         "alternately with this one in one session, and print the ratio")
@@ -31,19 +32,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_against(args: argparse.Namespace) -> int:
-    from clearbench.harness.studies.against import Case, resolve, side_by_side
-
-    if args.name not in CASES:
-        raise UserError(f"--against applies to {', '.join(CASES)}, not {args.name!r}")
     try:
         commit = resolve(args.against)
     except ValueError as error:
         raise UserError(str(error)) from error
     if args.repeat < 1:
         raise UserError(f"--repeat must be >= 1, got {args.repeat}")
-    presets = args.presets or DEFAULT_PRESETS[args.name]
+    presets = args.presets or DEFAULT_PRESETS[args.benchmark]
     cases = [Case(scene, preset, args.horizon or horizon, parameters)
-             for preset in presets for scene, parameters, horizon in CASES[args.name]
+             for preset in presets for scene, parameters, horizon in CASES[args.benchmark]
              if not args.scenes or scene in args.scenes]
     print(f"Reference engine, baseline {args.against} ({commit[:10]}) and this revision, "
           f"alternately in one session, {args.repeat} run(s) of each on each side, best kept "

@@ -1,7 +1,10 @@
-"""``clearbench c60 validate``: the C-60 validation table against the published figures.
+"""``clearbench c60``: the C-60 circuit-breaker tools.
 
-Runs the C-60 scenes it needs with the reference engine (cached per scene content in
-``--cache``), prints the table and writes it as Markdown with force-displacement figures.
+- ``clearbench c60 validate``: the validation table against the published figures. Runs the
+  C-60 scenes it needs with the reference engine (cached per scene content in ``--cache``),
+  prints the table and writes it as Markdown with force-displacement figures.
+- ``clearbench c60 angles TRAJECTORY.npz``: each body's angle about z and the largest body
+  speed along a run (a diagnostic, for example of a cached run).
 """
 
 from __future__ import annotations
@@ -10,7 +13,11 @@ import argparse
 import math
 from pathlib import Path
 
-from clearbench.harness.cli.main import UserError
+from clearbench.adapters.reference import ReferenceEngine
+from clearbench.adapters.trajectory import Trajectory
+from clearbench.harness.c60.angles import body_angles
+from clearbench.harness.c60.validation import validate, write_figures, write_json, write_markdown
+from clearbench.harness.cli.common import UserError
 
 DEFAULT_REPORT = Path("reports/c60_validation.md")
 DEFAULT_FIGURES = Path("reports/figures")
@@ -22,7 +29,8 @@ def register(subparsers) -> None:
         "c60", help="C-60 circuit breaker: validation against the published figures",
         description="C-60 circuit-breaker tools. `clearbench c60 validate` runs the C-60 "
         "scenes with the reference engine and compares FC-1, the functional conditions, the "
-        "trip and the bench tests of Section 5 with the paper's figures.",
+        "trip and the bench tests of Section 5 with the paper's figures; `clearbench c60 "
+        "angles` prints each body's angle along a trajectory.",
     )
     commands = parser.add_subparsers(dest="c60_command", metavar="C60_COMMAND")
     commands.required = True
@@ -45,19 +53,24 @@ def register(subparsers) -> None:
     validate.add_argument("--no-sensitivity", action="store_true",
                           help="skip the sensitivity runs (design arm, alternative preload)")
     validate.set_defaults(handler=run_validate)
+    angles = commands.add_parser(
+        "angles", help="each body's angle about z and the largest speed along a trajectory",
+        description="For a trajectory written by the reference engine (for example the cache "
+        "of `clearbench c60 validate`: .cache/c60/contact_force_test.npz), print every EVERY "
+        "ms the absolute angle of each body about z (the angle the source's angle laws use, "
+        "in (-pi, pi]) and the largest body speed. A diagnostic; asserts nothing.",
+    )
+    angles.add_argument("trajectory", type=Path, metavar="TRAJECTORY.npz")
+    angles.add_argument("--every", type=float, default=1.0, metavar="MS",
+                        help="time between printed samples [ms] (default 1)")
+    angles.set_defaults(handler=run_angles)
 
 
 def run_validate(args: argparse.Namespace) -> int:
-    from clearbench.adapters.reference.engine import PRESETS
-    from clearbench.harness.c60.validation import (
-        validate,
-        write_figures,
-        write_json,
-        write_markdown,
-    )
-
-    if args.preset not in PRESETS:
-        raise UserError(f"unknown preset {args.preset!r}; presets: {', '.join(PRESETS)}")
+    try:
+        ReferenceEngine(args.preset)   # the engine's own preset check, before any run
+    except ValueError as error:
+        raise UserError(str(error)) from None
     report = validate(cache=args.cache, preset=args.preset,
                       speed_check=not args.no_speed_check,
                       sensitivity=not args.no_sensitivity)
@@ -75,4 +88,18 @@ def run_validate(args: argparse.Namespace) -> int:
     print(f"report: {args.out} (and {args.out.with_suffix('.json')} for `clearbench report`)")
     for path in figures.values():
         print(f"figure: {path}")
+    return 0
+
+
+def run_angles(args: argparse.Namespace) -> int:
+    if not args.trajectory.is_file():
+        raise UserError(f"{args.trajectory}: no such file")
+    if not args.every > 0:
+        raise UserError(f"--every {args.every}: must be > 0")
+    trajectory = Trajectory.load(args.trajectory)
+    print("t [ms]  " + "  ".join(f"{n[:12]:>12s}" for n in trajectory.body_names)
+          + "  max speed")
+    for sample in body_angles(trajectory, args.every):
+        print(f"{sample.time:6.2f}  " + "  ".join(f"{a:12.3f}" for a in sample.angles)
+              + f"  {sample.max_speed:9.3g}")
     return 0

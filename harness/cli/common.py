@@ -1,4 +1,11 @@
-"""Options shared by the sub-commands that run engines (store, parallelism, limits, plugins)."""
+"""What the sub-commands share: :class:`UserError` and the options of the commands that run
+engines (store, parallelism, limits, plugins).
+
+Bad input is reported by :func:`clearbench.harness.cli.main.main` as one line on stderr with
+exit status 2: a command raises :class:`UserError` for a bad option of its own, and lets the
+input errors of the layers below (:class:`~clearbench.harness.run.engine_choice.RunInputError`,
+:class:`~clearbench.scenarios.validation.SceneError`) propagate unchanged.
+"""
 
 from __future__ import annotations
 
@@ -7,11 +14,14 @@ import os
 import sys
 from pathlib import Path
 
-from clearbench.harness.cli.main import UserError
-from clearbench.harness.run.engine_choice import RunInputError
 from clearbench.harness.run.runner import Runner, default_jobs
 from clearbench.harness.run.spec import DEFAULT_TIMEOUT, parse_assignment
 from clearbench.harness.run.store import ResultsStore
+
+
+class UserError(Exception):
+    """Bad input from the user: printed as one line on stderr, exit status 2."""
+
 
 #: Store used when --store is not given (overridden by the CLEARBENCH_STORE variable).
 DEFAULT_STORE = "reports/store"
@@ -68,14 +78,7 @@ def engine_modules(args: argparse.Namespace) -> dict[str, str]:
 
 def assignments(items: list[str], option: str) -> dict:
     """``['a=1', 'b=x']`` -> ``{'a': 1, 'b': 'x'}`` (values read as TOML literals)."""
-    out = {}
-    for text in items or []:
-        try:
-            key, value = parse_assignment(text, option)
-        except RunInputError as error:
-            raise UserError(str(error)) from None
-        out[key] = value
-    return out
+    return dict(parse_assignment(text, option) for text in items or [])
 
 
 def make_runner(args: argparse.Namespace, store: ResultsStore, total: int) -> Runner:
@@ -87,7 +90,3 @@ def make_runner(args: argparse.Namespace, store: ResultsStore, total: int) -> Ru
     return Runner(store, jobs=args.jobs, runs_per_worker=args.runs_per_worker,
                   progress=progress)
 
-
-def input_error(error: RunInputError) -> UserError:
-    """A run input error as the CLI reports it."""
-    return UserError(str(error))

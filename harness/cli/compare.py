@@ -6,12 +6,12 @@ import argparse
 import time
 
 from clearbench.harness.cli.common import (
+    UserError,
     add_runner_options,
     engine_modules,
     make_runner,
     open_store,
 )
-from clearbench.harness.cli.main import UserError
 from clearbench.harness.cli.sweep import print_work_precision
 from clearbench.harness.report.page import write_report
 from clearbench.harness.run.engine_choice import RunInputError, resolve_engine
@@ -71,22 +71,19 @@ def add_compare_options(parser: argparse.ArgumentParser) -> None:
 def run_compare(args: argparse.Namespace) -> int:
     start = time.monotonic()
     modules = engine_modules(args)
+    engines = ([resolve_engine(e, modules, field="--engines") for e in args.engines]
+               if args.engines else available_engines(modules))
+    if not engines:
+        raise UserError("no engine is available here (see `clearbench list`)")
+    reference = None
     try:
-        engines = ([resolve_engine(e, modules, field="--engines") for e in args.engines]
-                   if args.engines else available_engines(modules))
-        if not engines:
-            raise UserError("no engine is available here (see `clearbench list`)")
-        reference = None
-        try:
-            reference = resolve_engine(REFERENCE_ENGINE, modules)
-        except RunInputError as error:
-            print(f"note: no fine reference runs: {error}")
-        scenes = args.scenes or compare_scenes()
-        plan = plan_sweep(scenes, engines, parse_ladder(args.dt), timeout=args.timeout,
-                          reference=reference, fine_factor=FINE_FACTOR, campaign="compare")
-        stiff = plan_stability(engines, timeout=args.timeout) if args.stability else []
+        reference = resolve_engine(REFERENCE_ENGINE, modules)
     except RunInputError as error:
-        raise UserError(str(error)) from None
+        print(f"note: no fine reference runs: {error}")
+    scenes = args.scenes or compare_scenes()
+    plan = plan_sweep(scenes, engines, parse_ladder(args.dt), timeout=args.timeout,
+                      reference=reference, fine_factor=FINE_FACTOR, campaign="compare")
+    stiff = plan_stability(engines, timeout=args.timeout) if args.stability else []
     store = open_store(args)
     labels = ", ".join(e.label for e in engines)
     print(f"Comparing {labels} on {len(scenes)} scenes (ladder {args.dt}"

@@ -6,7 +6,8 @@ import csv
 import math
 from pathlib import Path
 
-from clearbench.harness.cli.main import UserError
+from clearbench.adapters.siconos.process import siconos_availability
+from clearbench.harness.cli.common import UserError
 from clearbench.harness.fclib.compare import (
     ALL_SOLVERS,
     CompareSettings,
@@ -70,8 +71,6 @@ def _format_row(row: RunRow) -> str:
 
 
 def run(args) -> int:
-    from clearbench.adapters.siconos.process import siconos_availability
-
     files = [Path(f) for f in args.files] or shipped_problem_files()
     for path in files:
         if not path.is_file():

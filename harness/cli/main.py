@@ -1,35 +1,42 @@
 """The ``clearbench`` command line.
 
 Each sub-command lives in its own module that exposes ``register(subparsers)``; this module only
-assembles them. Errors that come from bad user input are reported on stderr with a non-zero exit
-status, never as a traceback.
+assembles them, and is the one place where bad input becomes an error message: a
+:class:`~clearbench.harness.cli.common.UserError` (a bad option of a command), a
+:class:`~clearbench.harness.run.engine_choice.RunInputError` (unknown scene, engine, preset,
+bad setting) or a :class:`~clearbench.scenarios.validation.SceneError` (an invalid scene) is
+printed as one line on stderr with exit status 2, never as a traceback.
 """
 
 from __future__ import annotations
 
 import argparse
-import importlib
 import logging
 import sys
 
-#: Modules that each add one or more sub-commands (``register(subparsers)``).
-COMMAND_MODULES: tuple[str, ...] = (
-    "clearbench.harness.cli.scenes",
-    "clearbench.harness.cli.run",
-    "clearbench.harness.cli.sweep",
-    "clearbench.harness.cli.stability",
-    "clearbench.harness.cli.compare",
-    "clearbench.harness.cli.report",
-    "clearbench.harness.cli.regress",
-    "clearbench.harness.cli.bench_mujoco",
-    "clearbench.harness.cli.fclib",
-    "clearbench.harness.cli.bench",
-    "clearbench.harness.cli.c60",
+from clearbench.harness.cli import (
+    bench,
+    c60,
+    campaign,
+    compare,
+    fclib,
+    regress,
+    report,
+    run,
+    scenes,
+    stability,
+    sweep,
 )
+from clearbench.harness.cli.common import UserError
+from clearbench.harness.run.engine_choice import RunInputError
+from clearbench.scenarios.validation import SceneError
 
+#: Modules that each add one or more sub-commands (``register(subparsers)``), in help order.
+COMMAND_MODULES = (scenes, run, sweep, stability, compare, report, regress, fclib, bench, c60,
+                   campaign)
 
-class UserError(Exception):
-    """Bad input from the user: printed as one line on stderr, exit status 2."""
+#: Errors that mean bad input: reported in one line, exit status 2.
+INPUT_ERRORS = (UserError, RunInputError, SceneError)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -41,8 +48,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress to stderr")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
     subparsers.required = True
-    for module_name in COMMAND_MODULES:
-        importlib.import_module(module_name).register(subparsers)
+    for module in COMMAND_MODULES:
+        module.register(subparsers)
     return parser
 
 
@@ -56,7 +63,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     try:
         return int(args.handler(args) or 0)
-    except UserError as error:
+    except INPUT_ERRORS as error:
         print(f"clearbench {args.command}: error: {error}", file=sys.stderr)
         return 2
     except BrokenPipeError:  # output piped into `head` and the like

@@ -5,8 +5,7 @@ from __future__ import annotations
 import argparse
 import time
 
-from clearbench.harness.cli.common import engine_modules
-from clearbench.harness.cli.main import UserError
+from clearbench.harness.cli.common import UserError, engine_modules
 from clearbench.harness.run.engine_choice import RunInputError
 from clearbench.harness.studies.regress import (
     DEFAULT_BASELINE,

@@ -7,15 +7,14 @@ import json
 import shutil
 
 from clearbench.harness.cli.common import (
+    UserError,
     add_runner_options,
     assignments,
     engine_modules,
     make_runner,
     open_store,
 )
-from clearbench.harness.cli.main import UserError
 from clearbench.harness.measure.headline import format_value
-from clearbench.harness.run.engine_choice import RunInputError
 from clearbench.harness.run.spec import make_run_spec
 
 
@@ -48,16 +47,13 @@ def register(subparsers) -> None:
 
 
 def run_one(args: argparse.Namespace) -> int:
-    try:
-        spec = make_run_spec(args.scene, args.engine,
-                             scene_parameters=assignments(args.set, "--set"),
-                             time_step=args.dt, horizon=args.horizon,
-                             record_every=args.record_every,
-                             options=assignments(args.option, "--option"),
-                             timeout=args.timeout, extra_engine_modules=engine_modules(args),
-                             campaign="run")
-    except RunInputError as error:
-        raise UserError(str(error)) from None
+    spec = make_run_spec(args.scene, args.engine,
+                         scene_parameters=assignments(args.set, "--set"),
+                         time_step=args.dt, horizon=args.horizon,
+                         record_every=args.record_every,
+                         options=assignments(args.option, "--option"),
+                         timeout=args.timeout, extra_engine_modules=engine_modules(args),
+                         campaign="run")
     store = open_store(args)
     runner = make_runner(args, store, 1)
     outcome = runner.run_all([spec], rerun=args.rerun)

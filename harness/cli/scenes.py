@@ -6,8 +6,9 @@ import argparse
 import sys
 import textwrap
 
-from clearbench.adapters.registry import all_availability
-from clearbench.harness.cli.main import UserError
+from clearbench.adapters import all_availability
+from clearbench.harness.cli.common import UserError
+from clearbench.harness.cli.compare import add_compare_options, run_compare
 from clearbench.scenarios.library import SCENES, get_entry, scene_names
 from clearbench.scenarios.serialization import (
     load_scene_file,
@@ -55,8 +56,6 @@ def register(subparsers) -> None:
         "the default comparison of the available engines (`clearbench compare`) and write the "
         "report. Takes the options of `compare`.",
     )
-    from clearbench.harness.cli.compare import add_compare_options
-
     add_compare_options(demo)
     demo.set_defaults(handler=run_demo)
 
@@ -139,6 +138,4 @@ def run_demo(args: argparse.Namespace) -> int:
         state = "available" if availability.available else "unavailable"
         print(f"  {availability.engine:<10} {state:<12} {availability.detail}")
     print()
-    from clearbench.harness.cli.compare import run_compare
-
     return run_compare(args)

@@ -5,14 +5,13 @@ from __future__ import annotations
 import argparse
 
 from clearbench.harness.cli.common import (
+    UserError,
     add_runner_options,
     engine_modules,
     make_runner,
     open_store,
 )
-from clearbench.harness.cli.main import UserError
 from clearbench.harness.measure.headline import METRIC_LABELS, format_value
-from clearbench.harness.run.engine_choice import RunInputError
 from clearbench.harness.studies.stability import (
     STIFF_TAG,
     available_engines,
@@ -40,14 +39,11 @@ def register(subparsers) -> None:
 
 def run_stability(args: argparse.Namespace) -> int:
     modules = engine_modules(args)
-    try:
-        engines = (resolve_engines(args.engines, modules) if args.engines
-                   else available_engines(modules))
-        if not engines:
-            raise UserError("no engine is available here (see `clearbench list`)")
-        specs = plan_stability(engines, args.scenes, timeout=args.timeout)
-    except RunInputError as error:
-        raise UserError(str(error)) from None
+    engines = (resolve_engines(args.engines, modules) if args.engines
+               else available_engines(modules))
+    if not engines:
+        raise UserError("no engine is available here (see `clearbench list`)")
+    specs = plan_stability(engines, args.scenes, timeout=args.timeout)
     store = open_store(args)
     runner = make_runner(args, store, len(specs))
     outcome = runner.run_all(specs, rerun=args.rerun)

@@ -5,13 +5,13 @@ from __future__ import annotations
 import argparse
 
 from clearbench.harness.cli.common import (
+    UserError,
     add_runner_options,
     assignments,
     engine_modules,
     make_runner,
     open_store,
 )
-from clearbench.harness.cli.main import UserError
 from clearbench.harness.measure.headline import format_value
 from clearbench.harness.run.engine_choice import RunInputError, resolve_engine
 from clearbench.harness.studies.sweep import (
@@ -76,26 +76,23 @@ def selected_scenes(names: list[str], tag: str | None) -> list[str]:
 def run_sweep(args: argparse.Namespace) -> int:
     scenes = selected_scenes(args.scenes, args.tag)
     modules = engine_modules(args)
-    try:
-        ladder = parse_ladder(args.dt)
-        engines = resolve_engines(args.engines, modules)
-        reference = None
-        if args.reference_engine.lower() != "none":
-            try:
-                reference = resolve_engine(args.reference_engine, modules,
-                                           field="--reference-engine")
-            except RunInputError as error:
-                print(f"note: no fine reference runs ({error}); error is measured only "
-                      "where the scene has an analytic reference")
-        if not args.fine_factor > 0:
-            raise RunInputError("--fine-factor", args.fine_factor, "must be > 0")
-        plan = plan_sweep(scenes, engines, ladder,
-                          scene_parameters=assignments(args.set, "--set"),
-                          horizon=args.horizon, record_every=args.record_every,
-                          timeout=args.timeout, reference=reference,
-                          fine_factor=args.fine_factor)
-    except RunInputError as error:
-        raise UserError(str(error)) from None
+    ladder = parse_ladder(args.dt)
+    engines = resolve_engines(args.engines, modules)
+    reference = None
+    if args.reference_engine.lower() != "none":
+        try:
+            reference = resolve_engine(args.reference_engine, modules,
+                                       field="--reference-engine")
+        except RunInputError as error:
+            print(f"note: no fine reference runs ({error}); error is measured only "
+                  "where the scene has an analytic reference")
+    if not args.fine_factor > 0:
+        raise RunInputError("--fine-factor", args.fine_factor, "must be > 0")
+    plan = plan_sweep(scenes, engines, ladder,
+                      scene_parameters=assignments(args.set, "--set"),
+                      horizon=args.horizon, record_every=args.record_every,
+                      timeout=args.timeout, reference=reference,
+                      fine_factor=args.fine_factor)
     store = open_store(args)
     runner = make_runner(args, store, len(plan.all_specs))
     outcome = execute_plan(plan, runner, rerun=args.rerun)

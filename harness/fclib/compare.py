@@ -200,7 +200,7 @@ def performance_profile(rows: list[RunRow]) -> tuple[np.ndarray, dict[str, np.nd
 
 def plot_performance_profile(rows: list[RunRow], path, title: str = "") -> None:
     """Write the Dolan–Moré profile of ``rows`` as a PNG (matplotlib, Agg backend)."""
-    import matplotlib
+    import matplotlib  # lazy: matplotlib is loaded only when a figure is drawn
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

@@ -96,7 +96,7 @@ def condense_global(M, H, f: np.ndarray, w: np.ndarray) -> tuple[sp.csr_matrix, 
 
 def read_fclib(path: str | Path) -> LoadedProblem:
     """Read an FCLIB HDF5 file (local or global problem)."""
-    import h5py
+    import h5py  # lazy: h5py is loaded only to read FCLIB's HDF5 files
 
     path = Path(path)
     with h5py.File(path, "r") as handle:

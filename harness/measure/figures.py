@@ -1,8 +1,10 @@
 """The figures of one run: drift, stiction, energy, error, solver statistics, and the verdict.
 
-Computed from the trajectory and the scene with the shared metrics (:mod:`.metrics`) and the
-expectations (:mod:`.expectations`), never from an engine's own report. Every figure is a float
-in the scene's units (named below); a figure that does not apply to the scene is absent.
+:func:`measure` computes them from the trajectory and the scene with the per-sample kernels
+(:mod:`.series`), the expectation figures (:mod:`.expectation_figures`) and their criteria
+(:mod:`.verdicts`), never from an engine's own report; the worker stores them with every run.
+Every figure is a float in the scene's units (named below); a figure that does not apply to the
+scene is absent.
 
 =======================================  =====================================================
 ``penetration_max``                      max over pairs and samples of max(0, -gap) [L]
@@ -20,10 +22,10 @@ in the scene's units (named below); a figure that does not apply to the scene is
 ``energy_growth``                        max rise of E above its running minimum / scale [-]
 ``output_error.NAME``                    max |y - y_ref| on named output NAME [its unit]
 ``error``                                headline error (relative): analytic where the scene
-                                         has an analytic reference (see judgement.py), else the
+                                         has an analytic reference (see verdicts.py), else the
                                          largest relative output error against the reference
                                          trajectory [-]
-``EXPECTATION.FIGURE``                   every figure of every expectation (expectations.py)
+``EXPECTATION.FIGURE``                   every figure of every expectation (expectation_figures)
 ``solver_unconverged_steps``             recorded steps whose one-step problem did not converge
 ``solver_residual_max``                  largest recorded residual (engine's measure) [-]
 ``solver_iterations_mean``               mean recorded iterations
@@ -45,7 +47,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from clearbench.adapters.trajectory import RunStatus, Trajectory
+from clearbench.harness.measure import series as metrics
+from clearbench.harness.measure.expectation_figures import evaluate
+from clearbench.harness.measure.verdicts import ANALYTIC_ERROR, analytic_error, judge
 from clearbench.scenarios.bodies import Motion
+from clearbench.scenarios.scales import contact_feature_sizes, scene_size
 from clearbench.scenarios.scene import Scene
 
 LOG = logging.getLogger(__name__)
@@ -76,8 +82,6 @@ class Measurement:
 
 def has_analytic_reference(scene: Scene) -> bool:
     """True when an expectation of the scene has an analytic solution to measure error by."""
-    from clearbench.harness.measure.verdicts import ANALYTIC_ERROR
-
     return any(e.kind in ANALYTIC_ERROR for e in scene.expectations)
 
 
@@ -98,35 +102,9 @@ def first_non_finite(trajectory: Trajectory) -> str | None:
     return None
 
 
-def shape_size(shape) -> float:
-    """Smallest characteristic size of a shape [L] (inf for a half-space)."""
-    if hasattr(shape, "half_extents"):
-        return float(min(shape.half_extents))
-    if hasattr(shape, "radius"):
-        return float(shape.radius)
-    return math.inf
-
-
-def _body_size(body) -> float:
-    from clearbench.harness.measure import series as metrics
-
-    return metrics.body_size(body)
-
-
-def scene_size(scene: Scene) -> float:
-    """Length scale of the scene's initial configuration [L] (> 0)."""
-    positions = np.array([b.position for b in scene.bodies], dtype=float)
-    spread = float(np.max(np.ptp(positions, axis=0))) if len(positions) > 1 else 0.0
-    size = max([spread] + [_body_size(b) for b in scene.bodies])
-    return size if size > 0 else 1.0
-
-
 def _expectation_results(scene: Scene, trajectory: Trajectory, out: _Collector):
     """Every expectation's figures (also flattened into ``NAME.FIGURE`` figures), pass/fail
-    and criterion (:mod:`.judgement`), and the analytic error with its source."""
-    from clearbench.harness.measure.expectation_figures import evaluate
-    from clearbench.harness.measure.verdicts import analytic_error, judge
-
+    and criterion (:mod:`.verdicts`), and the analytic error with its source."""
     bodies = {e.name: e.body for e in scene.expectations}
     results = []
     errors = []
@@ -202,21 +180,16 @@ def measure(scene: Scene, trajectory: Trajectory, reference: Trajectory | None =
     status = trajectory.status
     if status is not RunStatus.OK or len(trajectory.times) == 0:
         return Measurement(out.figures, (), status, trajectory.message)
-    try:
-        from clearbench.harness.measure import series as metrics
-    except ImportError as error:
-        return Measurement(out.figures, (), status, "",
-                           metrics_error=f"metrics unavailable: {error}")
     reasons: list[str] = []
 
     with out.guard("drift"):
-        _drift(scene, trajectory, metrics, out, reasons)
+        _drift(scene, trajectory, out, reasons)
     with out.guard("stiction"):
-        _stiction(scene, trajectory, metrics, out)
+        _stiction(scene, trajectory, out)
     with out.guard("energy"):
-        _energy(scene, trajectory, metrics, out, reasons)
+        _energy(scene, trajectory, out, reasons)
     with out.guard("escape"):
-        _escape(scene, trajectory, metrics, reasons)
+        _escape(scene, trajectory, reasons)
 
     results: list[dict] = []
     error, source = math.nan, ""
@@ -224,7 +197,7 @@ def measure(scene: Scene, trajectory: Trajectory, reference: Trajectory | None =
         results, error, source = _expectation_results(scene, trajectory, out)
     if math.isnan(error) and reference is not None and scene.outputs:
         with out.guard("reference error"):
-            error = _output_error(scene, trajectory, reference, metrics, out)
+            error = _output_error(scene, trajectory, reference, out)
             source = reference_label if math.isfinite(error) else ""
     if math.isfinite(error):
         out.put("error", error)
@@ -233,15 +206,13 @@ def measure(scene: Scene, trajectory: Trajectory, reference: Trajectory | None =
                        "; ".join(out.errors))
 
 
-def _drift(scene, trajectory, metrics, out: _Collector, reasons: list[str]) -> None:
+def _drift(scene, trajectory, out: _Collector, reasons: list[str]) -> None:
     out.put("quaternion_norm_error_max", np.max(metrics.quaternion_norm_error(trajectory)))
     contacts = scene.expanded.contacts
     if contacts:
         depth = metrics.penetration(scene, trajectory)
         out.put("penetration_max", np.max(depth))
-        shapes = {(b.name, s.name): s for b in scene.expanded.bodies for s in b.shapes}
-        feature = np.array([min(shape_size(shapes[(c.body_a, c.shape_a)]),
-                                shape_size(shapes[(c.body_b, c.shape_b)])) for c in contacts])
+        feature = contact_feature_sizes(scene)
         relative = np.max(depth, axis=0) / feature
         out.put("penetration_relative", np.max(relative))
         worst = int(np.argmax(relative))
@@ -265,7 +236,7 @@ def _drift(scene, trajectory, metrics, out: _Collector, reasons: list[str]) -> N
         out.put("joint_angle_max", np.max(violation.angle))
 
 
-def _stiction(scene, trajectory, metrics, out: _Collector) -> None:
+def _stiction(scene, trajectory, out: _Collector) -> None:
     worst = None
     for expectation in scene.expectations:
         if expectation.kind not in STICK_KINDS:
@@ -281,19 +252,12 @@ def _stiction(scene, trajectory, metrics, out: _Collector) -> None:
         out.put("stiction_creep_rate", worst.creep_rate)
 
 
-def energy_scale(scene: Scene, energy) -> float:
-    """The shared energy scale (:func:`clearbench.harness.measure.series.energy_scale`)."""
-    from clearbench.harness.measure import series as metrics
-
-    return metrics.energy_scale(scene, energy)
-
-
-def _energy(scene, trajectory, metrics, out: _Collector, reasons: list[str]) -> None:
+def _energy(scene, trajectory, out: _Collector, reasons: list[str]) -> None:
     if scene.features & WORKING_FEATURES:
         return
     energy = metrics.energy(scene, trajectory)
     total = energy.total
-    scale = energy_scale(scene, energy)
+    scale = metrics.energy_scale(scene, energy)
     out.put("energy_scale", scale)
     out.put("energy_drift", np.max(np.abs(total - total[0])) / scale)
     rise, rise_scale = metrics.energy_growth(scene, trajectory, energy)
@@ -306,7 +270,7 @@ def _energy(scene, trajectory, metrics, out: _Collector, reasons: list[str]) -> 
                        "(energy that may not grow)")
 
 
-def _escape(scene, trajectory, metrics, reasons: list[str]) -> None:
+def _escape(scene, trajectory, reasons: list[str]) -> None:
     positions = metrics.centre_of_mass_positions(scene, trajectory)
     moved = np.linalg.norm(positions - positions[:1], axis=2)
     horizon = float(trajectory.times[-1] - trajectory.times[0])
@@ -323,7 +287,7 @@ def _escape(scene, trajectory, metrics, reasons: list[str]) -> None:
             return
 
 
-def _output_error(scene, trajectory, reference, metrics, out: _Collector) -> float:
+def _output_error(scene, trajectory, reference, out: _Collector) -> float:
     """Max |y - y_ref| per named output (reference interpolated to the run's samples, within
     its time span); returns the largest relative to the reference's range."""
     values = metrics.output_values(scene, trajectory)

@@ -1,8 +1,9 @@
-"""Engine-independent metrics, computed from a trajectory and its scene with the shared
+"""Per-sample metric kernels, computed from a trajectory and its scene with the shared
 geometry (never from an engine's own report of its penetration or energy).
 
-Every function takes the scene (as the engine was given it) and a :class:`Trajectory` and
-returns arrays over the recorded samples, in the scene's units.
+Every metric takes the scene (as the engine was given it) and a :class:`Trajectory` and
+returns arrays over the recorded samples, in the scene's units. The scales the metrics are
+judged against (:func:`shape_size`, :func:`body_size`, :func:`energy_scale`) are here too.
 """
 
 from __future__ import annotations
@@ -22,8 +23,16 @@ from clearbench.kernels.quaternion import (
 )
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.geometry import contacts_between
-from clearbench.scenarios.loads import LinearSpringDamper, TorsionalSpringDamper
+from clearbench.scenarios.loads import (
+    AngleLawLoad,
+    DistanceLawLoad,
+    LinearSpringDamper,
+    Moment,
+    PointForce,
+    TorsionalSpringDamper,
+)
 from clearbench.scenarios.outputs import BodyAngle, ContactForce, PointDistance, PointPosition
+from clearbench.scenarios.scales import body_size
 from clearbench.scenarios.scene import Scene
 
 
@@ -228,8 +237,6 @@ def energy(scene: Scene, trajectory: Trajectory) -> Energy:
 def non_conservative_loads(scene: Scene) -> tuple[str, ...]:
     """Names of the loads whose work :func:`energy` cannot count (law loads, time-switched
     forces and moments): an energy expectation is meaningless while they act."""
-    from clearbench.scenarios.loads import AngleLawLoad, DistanceLawLoad, Moment, PointForce
-
     return tuple(load.name for load in scene.loads
                  if isinstance(load, AngleLawLoad | DistanceLawLoad | PointForce | Moment))
 
@@ -292,17 +299,6 @@ def output_values(scene: Scene, trajectory: Trajectory) -> dict[str, np.ndarray]
 def rotation_matrices(trajectory: Trajectory) -> np.ndarray:
     """(T, nb, 3, 3) body-to-world rotations."""
     return quat_to_matrix_batch(quat_normalize_batch(trajectory.orientations))
-
-
-def body_size(body) -> float:
-    """Size of a body [L]: its largest shape extent, or its centre-of-mass offset."""
-    sizes = []
-    for shape in body.shapes:
-        if hasattr(shape, "half_extents"):
-            sizes.append(float(np.linalg.norm(shape.half_extents)))
-        elif hasattr(shape, "radius"):
-            sizes.append(float(shape.radius) + float(getattr(shape, "half_length", 0.0)))
-    return max(sizes + [float(np.linalg.norm(body.center_of_mass))])
 
 
 def energy_scale(scene: Scene, energy: Energy) -> float:

@@ -1,4 +1,6 @@
-"""Pass/fail of each expectation in the harness's results and report, and the analytic error.
+"""Pass/fail criteria: of each expectation in the harness's results and report, and which
+expectation figure is a run's analytic error. (The run's own verdict, ok or diverged, is
+:func:`clearbench.harness.measure.figures.measure`'s.)
 
 :func:`clearbench.harness.measure.expectation_figures.evaluate` states figures, not verdicts:
 what is acceptable depends on the use. These are the harness's criteria (shown in the report), each
@@ -31,9 +33,10 @@ from __future__ import annotations
 
 import math
 
+from clearbench.scenarios.scales import body_size, smallest_contact_feature
 from clearbench.scenarios.scene import Scene
 
-#: kind -> figure of :mod:`.expectations` that is the run's relative error against the
+#: kind -> figure of :mod:`.expectation_figures` that is the run's relative error against the
 #: analytic solution (first one present is used), and the figure that normalises it if any.
 ANALYTIC_ERROR: dict[str, tuple[tuple[str, str | None], ...]] = {
     "bounce_apex": (("apex_max_relative_error", None),),
@@ -63,24 +66,6 @@ def analytic_error(kind: str, figures: dict) -> float:
     return math.nan
 
 
-def _smallest_contact_feature(scene: Scene) -> float:
-    from clearbench.harness.measure.figures import shape_size
-
-    expanded = scene.expanded
-    shapes = {(b.name, s.name): s for b in expanded.bodies for s in b.shapes}
-    sizes = [min(shape_size(shapes[(c.body_a, c.shape_a)]),
-                 shape_size(shapes[(c.body_b, c.shape_b)])) for c in expanded.contacts]
-    sizes += [j.radial_clearance for j in scene.clearance_joints]
-    finite = [s for s in sizes if math.isfinite(s)]
-    return min(finite) if finite else math.inf
-
-
-def _body_size(scene: Scene, body: str) -> float:
-    from clearbench.harness.measure.figures import _body_size as size
-
-    return size(scene.body(body))
-
-
 def _within(value, bound) -> bool | None:
     if value is None or not math.isfinite(value):
         return None
@@ -94,7 +79,7 @@ def judge(scene: Scene, kind: str, body: str | None, figures: dict) -> tuple[boo
     if kind == "bounce_apex":
         return _within(get("apex_max_relative_error"), 0.05), "apex within 5 %"
     if kind in ("incline_stick", "sticks"):
-        bound = 1e-4 * _body_size(scene, body)
+        bound = 1e-4 * body_size(scene.body(body))
         return _within(get("displacement"), bound), f"displacement <= {bound:.3g}"
     if kind == "incline_slide":
         return _within(get("acceleration_relative_error"), 0.02), "acceleration within 2 %"
@@ -121,6 +106,6 @@ def judge(scene: Scene, kind: str, body: str | None, figures: dict) -> tuple[boo
     if kind == "energy_conserved":
         return _within(get("energy_drift_relative"), 0.01), "energy drift <= 1 %"
     if kind == "no_penetration":
-        bound = 0.01 * _smallest_contact_feature(scene)
+        bound = 0.01 * smallest_contact_feature(scene)
         return _within(get("penetration_max"), bound), f"penetration <= {bound:.3g}"
     return None, "no criterion"

@@ -15,7 +15,8 @@ import logging
 import numpy as np
 
 from clearbench.adapters.trajectory import Trajectory
-from clearbench.harness.measure.figures import STICK_KINDS, energy_scale
+from clearbench.harness.measure import series as metrics
+from clearbench.harness.measure.figures import STICK_KINDS
 from clearbench.scenarios.scene import Scene
 
 LOG = logging.getLogger(__name__)
@@ -25,7 +26,7 @@ PLOT_SAMPLES = 1200
 
 
 def _pyplot():
-    import matplotlib
+    import matplotlib  # lazy: matplotlib is loaded only when a figure is drawn
 
     matplotlib.use("Agg", force=True)
     import matplotlib.pyplot as plt
@@ -85,8 +86,6 @@ def subsample(trajectory: Trajectory, samples: int = PLOT_SAMPLES) -> Trajectory
 
 def time_series(scene: Scene, trajectory: Trajectory) -> dict[str, np.ndarray]:
     """Drift and creep series of one run, (T,) each, keyed by panel title (scene units)."""
-    from clearbench.harness.measure import series as metrics
-
     series: dict[str, np.ndarray] = {}
     length = scene.units.length
     if scene.expanded.contacts:
@@ -107,7 +106,7 @@ def time_series(scene: Scene, trajectory: Trajectory) -> dict[str, np.ndarray]:
     if not scene.features & {"drivers", "point_forces", "moments"}:
         energy = metrics.energy(scene, trajectory)
         total = energy.total
-        series["energy change / scale"] = (total - total[0]) / energy_scale(scene, energy)
+        series["energy change / scale"] = (total - total[0]) / metrics.energy_scale(scene, energy)
     return series
 
 

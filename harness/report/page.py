@@ -30,6 +30,9 @@ from clearbench.harness.measure.headline import (
 )
 from clearbench.harness.report.figures import time_series_figure, work_precision_figure
 from clearbench.harness.run.store import ResultsStore
+from clearbench.harness.studies.campaign.report import load_written_sections
+from clearbench.harness.studies.campaign.report import render_markdown as campaign_section_markdown
+from clearbench.harness.studies.campaign.report import section_html as campaign_section_html
 from clearbench.harness.studies.sweep import work_precision_points
 from clearbench.scenarios.scene import Scene
 
@@ -61,6 +64,8 @@ class ReportData:
     store: str
     generated: str
     c60_validation: dict | None = None   # clearbench c60 validate's JSON (see load_c60_validation)
+    #: tolerance campaigns written by ``clearbench campaign report`` (summary, figures)
+    campaigns: list = field(default_factory=list)
 
 
 def _representative(rows, scene: Scene | None) -> dict:
@@ -366,6 +371,7 @@ def render_html(data: ReportData) -> str:
         _overview_html(data, stiff=True),
         *(_section_html(s) for s in data.sections),
         _c60_html(data.c60_validation) if data.c60_validation else "",
+        *(campaign_section_html(summary, pngs) for summary, pngs in data.campaigns),
         _engines_html(data),
     ]
     return ("<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
@@ -416,6 +422,8 @@ def render_markdown(data: ReportData, figure_files: dict, c60_figure_files: dict
         lines.append("")
     if data.c60_validation:
         lines += _c60_markdown(data.c60_validation, c60_figure_files or {})
+    for summary, pngs in data.campaigns:
+        lines += ["", campaign_section_markdown(summary, list(pngs))]
     notes = _engine_notes(data)
     if notes:
         lines += ["## Engine approximations", "", "| engine | feature | support | how |",
@@ -427,18 +435,28 @@ def render_markdown(data: ReportData, figure_files: dict, c60_figure_files: dict
 
 #: Where ``clearbench c60 validate`` writes its JSON (committed with the repository).
 C60_VALIDATION = Path("reports/c60_validation.json")
+#: Where ``clearbench campaign report`` writes by default.
+CAMPAIGNS = Path("reports/campaigns")
 
 
 def write_report(store: ResultsStore, out_dir: str | Path,
-                 c60_validation: str | Path | None = C60_VALIDATION) -> dict[str, Path]:
+                 c60_validation: str | Path | None = C60_VALIDATION,
+                 campaigns: str | Path | None = CAMPAIGNS) -> dict[str, Path]:
     """Write ``report.html``, ``summary.md`` and ``figures/*.png`` into ``out_dir``.
 
     ``c60_validation``: the JSON of ``clearbench c60 validate``; when it exists the report has
-    a section with the C-60 table against the paper and its force-displacement figures."""
+    a section with the C-60 table against the paper and its force-displacement figures.
+    ``campaigns``: the folder of ``clearbench campaign report``; each campaign written there
+    gets its tolerance section (statistics beside the paper's, histograms, sensitivities)."""
     out = Path(out_dir)
     (out / "figures").mkdir(parents=True, exist_ok=True)
     data = collect(store)
     data.c60_validation = load_c60_validation(c60_validation)
+    if campaigns is not None and Path(campaigns).is_dir():
+        data.campaigns = load_written_sections(campaigns)
+        for _, pngs in data.campaigns:
+            for name, png in pngs.items():
+                (out / "figures" / name).write_bytes(png)
     c60_figure_files: dict[str, str] = {}
     if data.c60_validation:
         for index, (title, png) in enumerate(data.c60_validation["figure_png"].items()):

@@ -1,12 +1,12 @@
 """Engine choices as users write them (``mujoco[elliptic]``), resolved and checked before any
 engine runs.
 
-An engine is found through :data:`clearbench.adapters.registry.ENGINE_MODULES`, or through
-extra adapter modules given by the caller (``{"mine": "my_package.my_adapter"}``), which follow
-the same contract (:mod:`clearbench.adapters.base`): ``availability() -> (bool, str)`` and
-``create(preset) -> Engine``. Where the adapter module declares ``PRESETS`` (a mapping) and
-``OPTION_NAMES`` (a sequence), presets and option names are checked against them without
-creating an engine.
+An engine is found through :data:`clearbench.adapters.ENGINES`, or through extra adapter
+modules given by the caller (``{"mine": "my_package.my_adapter"}``), which follow the same
+contract (:mod:`clearbench.adapters.base`): ``availability() -> (bool, str)`` and
+``create(preset) -> Engine``. The preset and the option names are checked by the engine itself
+(``create`` refuses an unknown preset, ``Engine.check_options`` unknown options), here turned
+into input errors naming the field.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-from clearbench.adapters.registry import ENGINE_MODULES, engine_availability
+from clearbench.adapters import ENGINES, engine_availability
 
 _LABEL = re.compile(r"^\s*([A-Za-z0-9_.-]+)\s*(?:\[\s*([A-Za-z0-9_.+-]*)\s*\])?\s*$")
 
@@ -61,9 +61,9 @@ def engine_module_path(name: str, extra_modules: Mapping[str, str] | None = None
     """Fully qualified adapter module of engine ``name``."""
     if extra_modules and name in extra_modules:
         return extra_modules[name]
-    if name in ENGINE_MODULES:
-        return f"clearbench.adapters.{ENGINE_MODULES[name]}"
-    known = sorted(set(ENGINE_MODULES) | set(extra_modules or {}))
+    if name in ENGINES:
+        return ENGINES[name]
+    known = sorted(set(ENGINES) | set(extra_modules or {}))
     raise RunInputError("engine", name, f"unknown engine; engines: {', '.join(known)}")
 
 
@@ -91,30 +91,25 @@ def resolve_engine(text: str, extra_modules: Mapping[str, str] | None = None,
         module = importlib.import_module(module_path) if available else None
     if not available:
         raise RunInputError(field, text, f"engine not available here: {detail}")
-    presets = getattr(module, "PRESETS", None)
-    if isinstance(presets, Mapping):
-        if preset not in presets:
-            raise RunInputError(f"{field} preset", preset,
-                                f"unknown {name} preset; presets: {', '.join(presets)}")
-    else:
-        try:
-            module.create(preset)
-        except Exception as error:
-            raise RunInputError(f"{field} preset", preset, f"{name} refused it: {error}") \
-                from None
-    choice = EngineChoice(name, preset, module_path, str(detail))
-    check_options(choice, options)
-    return choice
+    try:
+        engine = module.create(preset)
+    except Exception as error:  # the engine's own preset check (Engine.__init__)
+        raise RunInputError(f"{field} preset", preset, f"{name} refused it: {error}") \
+            from None
+    _check_engine_options(engine, options)
+    return EngineChoice(name, preset, module_path, str(detail))
 
 
 def check_options(choice: EngineChoice, options: Mapping | None) -> None:
-    """RunInputError when an option is unknown to an adapter that declares OPTION_NAMES."""
-    if not options:
-        return
-    option_names = getattr(importlib.import_module(choice.module), "OPTION_NAMES", None)
-    if option_names is None:
-        return
-    unknown = sorted(set(options) - set(option_names))
-    if unknown:
-        raise RunInputError("options", ", ".join(unknown),
-                            f"unknown {choice.name} options; options: {', '.join(option_names)}")
+    """RunInputError when the engine of ``choice`` does not have an option of ``options``."""
+    if options:
+        engine = importlib.import_module(choice.module).create(choice.preset)
+        _check_engine_options(engine, options)
+
+
+def _check_engine_options(engine, options: Mapping | None) -> None:
+    """The engine's own option check (``Engine.check_options``) as an input error."""
+    try:
+        engine.check_options(options)
+    except ValueError as error:
+        raise RunInputError("options", ", ".join(sorted(options or {})), str(error)) from None

@@ -23,7 +23,7 @@ import os
 import signal
 import time
 from collections import deque
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -181,7 +181,7 @@ class Runner:
             return outcome
         bar = None
         if self.progress:
-            from tqdm import tqdm
+            from tqdm import tqdm  # lazy: only for an interactive progress bar
 
             bar = tqdm(total=len(queue), unit="run", desc="runs", leave=False)
         try:
@@ -309,10 +309,3 @@ class _Finished:
     trajectory_tmp: Path | None
     worker_ok: bool
 
-
-def run_specs(specs: Sequence[RunSpec | RunJob], store: ResultsStore, jobs: int | None = None,
-              progress: bool = False, rerun: bool = False,
-              runs_per_worker: int = 1) -> SweepOutcome:
-    """Convenience: run ``specs`` with a fresh :class:`Runner`."""
-    runner = Runner(store, jobs=jobs, progress=progress, runs_per_worker=runs_per_worker)
-    return runner.run_all(specs, rerun=rerun)

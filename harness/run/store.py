@@ -76,7 +76,7 @@ class RunRecord:
     samples: int
     stepping_seconds_per_simulated_second: float
     stepping_seconds_per_step: float
-    error: float                 # headline error (relative, see run_metrics), NaN when none
+    error: float                 # headline error (relative, see measure.figures), NaN when none
     error_source: str
     expectations_passed: int | None   # 1 all passed, 0 one failed, None none judged
     metrics: str                 # JSON: flat name -> float
@@ -309,7 +309,7 @@ class ResultsStore:
 
     def dataframe(self, expand_metrics: bool = True):
         """Every run as a pandas DataFrame; ``m_<name>`` columns hold the metrics."""
-        import pandas as pd
+        import pandas as pd  # lazy: pandas only for the commands that tabulate the store
 
         with self._connect() as connection:
             frame = pd.read_sql_query("SELECT * FROM runs ORDER BY recorded_utc, key",

@@ -23,6 +23,7 @@ from pathlib import Path
 
 from clearbench.adapters.base import RunSettings
 from clearbench.adapters.trajectory import RunStatus, Trajectory
+from clearbench.harness.measure.figures import first_non_finite, measure
 from clearbench.scenarios.serialization import scene_from_dict
 
 LOG = logging.getLogger(__name__)
@@ -83,8 +84,6 @@ def run_phase(request: dict):
     scene, trajectory
         For the measuring phase (``trajectory`` None when the engine raised).
     """
-    from clearbench.harness.measure.figures import first_non_finite
-
     start = time.perf_counter()
     ran = {"phase": "ran", "status": RunStatus.CRASHED.value, "message": "",
            "engine_version": "", "capabilities": {}, "worker_seconds": 0.0,
@@ -131,9 +130,8 @@ def run_phase(request: dict):
 
 
 def measure_phase(request: dict, scene, trajectory: Trajectory | None) -> dict:
-    """Metrics, expectations and verdict of a finished run (see :mod:`.run_metrics`)."""
-    from clearbench.harness.measure.figures import measure
-
+    """Metrics, expectations and verdict of a finished run
+    (:func:`clearbench.harness.measure.figures.measure`)."""
     start = time.perf_counter()
     out = {"phase": "measured", "figures": {}, "expectations": [], "verdict": None,
            "verdict_reason": "", "error_source": "", "metrics_error": ""}

@@ -7,7 +7,7 @@ from __future__ import annotations
 import json
 from collections.abc import Sequence
 
-from clearbench.adapters.registry import all_availability
+from clearbench.adapters import all_availability
 from clearbench.harness.measure.headline import scene_metric_names
 from clearbench.harness.run.engine_choice import EngineChoice, resolve_engine
 from clearbench.harness.run.spec import DEFAULT_TIMEOUT, RunSpec, make_run_spec

@@ -2,9 +2,9 @@
 stepping time, and the Pareto front.
 
 The error of a run is the analytic one where the scene has an analytic reference
-(:func:`.run_metrics.has_analytic_reference`); otherwise the run's named outputs are compared with
-the reference solver's at a fine step (``fine_factor`` times the smallest step of the ladder),
-which the sweep runs first.
+(:func:`clearbench.harness.measure.figures.has_analytic_reference`); otherwise the run's named
+outputs are compared with the reference solver's at a fine step (``fine_factor`` times the
+smallest step of the ladder), which the sweep runs first.
 """
 
 from __future__ import annotations

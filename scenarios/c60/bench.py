@@ -89,7 +89,7 @@ def contact_force_test_scene(
 
     The handle spring acts at its design arm by default here (10 N mm about the handle's pivot
     instead of the source's 27, see :mod:`.c60_model`). Measured with the reference engine
-    over the first 10 ms (``benchmarks/c60_body_angles.py`` on the trajectory): with the
+    over the first 10 ms (``clearbench c60 angles`` on the trajectory): with the
     source's arm the handle leaves its ON pose within 1 ms of the moving contact landing on
     C6 (-0.34 rad at 6 ms, +0.68 rad at 10 ms, stroke 2.2 mm) and the mechanism opens; with
     the design arm it stays at -0.343 rad through 4.8 ms unloaded (stroke 2.4 mm).

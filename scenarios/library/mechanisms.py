@@ -12,7 +12,7 @@ from clearbench.scenarios.contacts import ContactPair
 from clearbench.scenarios.drivers import Driver
 from clearbench.scenarios.expectations import Expectation
 from clearbench.scenarios.inertia import diagonal
-from clearbench.scenarios.joints import ClearanceRevoluteJoint, RevoluteJoint
+from clearbench.scenarios.joints import ClearanceRevoluteJoint, PrismaticJoint, RevoluteJoint
 from clearbench.scenarios.outputs import BodyAngle, PointPosition
 from clearbench.scenarios.registry import register
 from clearbench.scenarios.scene import Scene
@@ -201,8 +201,6 @@ def slider_crank(crank_length: float = 0.1, rod_length: float = 0.3,
 
 
 def _prismatic_x(name: str, body_a: str, body_b: str, anchor: tuple):
-    from clearbench.scenarios.joints import PrismaticJoint
-
     return PrismaticJoint(name, body_a=body_a, body_b=body_b, anchor=anchor, axis=(1.0, 0, 0))
 
 

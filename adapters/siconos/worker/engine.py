@@ -113,8 +113,12 @@ def siconos_builtin_frame(normal):
     return np.array([n, first, np.cross(n, first)])
 
 
+# The two profile functions below copy clearbench.kernels.time_profiles (profile_value,
+# profile_slope) on purpose: this script runs under Debian's Python, which has neither numba nor
+# clearbench. tests/test_siconos_worker_loads.py holds them bitwise equal to the kernels.
 def evaluate_profile(times, values, t):
-    """Piecewise-linear profile value at t (same rule as ``scenarios.time_profiles``)."""
+    """Piecewise-linear profile value at t (``clearbench.kernels.time_profiles.profile_value``:
+    constant outside, right value at a jump)."""
     times = np.asarray(times, dtype=float)
     values = np.asarray(values, dtype=float)
     if len(times) == 1 or t < times[0]:
@@ -130,7 +134,8 @@ def evaluate_profile(times, values, t):
 
 
 def profile_rate(times, values, t):
-    """Slope of the current segment of a piecewise-linear position profile (0 outside)."""
+    """Slope of the current segment of a piecewise-linear position profile, 0 outside
+    (``clearbench.kernels.time_profiles.profile_slope``)."""
     for i in range(len(times) - 1):
         if times[i + 1] > times[i] and times[i] <= t < times[i + 1]:
             return (values[i + 1] - values[i]) / (times[i + 1] - times[i])
@@ -584,6 +589,7 @@ class SiconosModel:
     """The Siconos model of a scene and its stepping; every Siconos object stays referenced."""
 
     def __init__(self, scene, settings):
+        # Lazy imports of the engine package: the tests import this module without Siconos.
         import siconos.kernel as sk
         import siconos.mechanics.joints as joints
         import siconos.numerics as sn

@@ -151,7 +151,7 @@ def main(argv):
     input_path, output_path = argv[1], argv[2]
     result = {"ok": False, "message": ""}
     try:
-        import siconos.numerics as sn
+        import siconos.numerics as sn  # lazy: a missing Siconos is reported in the output file
 
         with np.load(input_path, allow_pickle=False) as inputs:
             mode = str(inputs["mode"])

@@ -1,0 +1,394 @@
+"""The step loop of an Exudyn run: solver settings, recording, guards, read-out.
+
+Exudyn is stepped by its own ``MainSolverImplicitSecondOrder`` (``InitializeSolver``,
+``SolveSteps``, ``FinalizeSolver``), one ``SolveSteps`` call per nominal step with the
+solver's end time at that step's end: a step Exudyn reduces (Newton failure, contact instant)
+is followed by smaller steps up to the grid time, so that every sample is at a multiple of
+the step (one call over the whole horizon leaves the grid after the first reduction). A
+PostStep user function (called after every accepted step, after the discontinuous iterations,
+and once more at the start of each call: skipped) records samples and runs the guards, and
+stops the solver by returning False. A PreStep function applies explicit law loads.
+
+Guards:
+- files: ``solution.file.write``, ``solution.sensors.active``, restart files, verbose files
+  off (Exudyn writes ``solution/coordinatesSolution.txt`` by default);
+- stdout: Exudyn prints through Python's ``sys.stdout`` (not file descriptor 1), e.g. its
+  "DYNAMIC SOLVER FAILED" banner: ``exudyn.config.printToConsole`` is switched off and
+  ``sys.stdout`` redirected during the solve; anything caught goes to the metadata;
+- solver failure: ``SolveSteps`` returning False or raising ``SolverError`` /
+  ``ExudynError`` (Newton failure after the step reductions, singular Jacobian) stops the run
+  as DIVERGED with Exudyn's error string (CRASHED for other exceptions);
+- non-finite state, and energy gain on scenes whose energy may not grow: DIVERGED.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import logging
+import math
+import time
+
+import numpy as np
+
+from clearbench.adapters.exudyn.build import BuiltSystem, load_exudyn
+from clearbench.adapters.exudyn.settings import ExudynSettings
+from clearbench.adapters.recording import SampleRecorder
+from clearbench.adapters.trajectory import RunStatus
+from clearbench.kernels.quaternion import quat_to_matrix_batch
+from clearbench.scenarios.bodies import Motion
+from clearbench.scenarios.loads import LinearSpringDamper
+from clearbench.scenarios.scales import largest_shape_dimension
+from clearbench.scenarios.scene import Scene
+
+logger = logging.getLogger(__name__)
+
+#: Expectation kinds under which the energy of the scene may not grow.
+ENERGY_EXPECTATIONS = ("energy_non_increasing", "energy_conserved")
+#: Features that do work the energy bookkeeping does not count (the guard stays off).
+WORK_FEATURES = ("drivers", "point_forces", "moments", "angle_law_loads", "distance_law_loads",
+                 "torsional_springs")
+
+
+def simulation_settings(settings: ExudynSettings, time_step: float, steps: int,
+                        closed_loop: bool = False):
+    """``exu.SimulationSettings`` of a run: the preset's solver options, every output off
+    (``closed_loop``: the scene's joints close a loop, see ``closed_loop_full_pivot``)."""
+    exu = load_exudyn()
+    s = exu.SimulationSettings()
+    ti = s.timeIntegration
+    ti.numberOfSteps = steps
+    ti.endTime = steps * time_step
+    ti.startTime = 0.0
+    ti.verboseMode = 0
+    ti.verboseModeFile = 0
+    ti.adaptiveStep = settings.adaptive_step
+    ti.minimumStepSize = settings.minimum_step_fraction * time_step
+    ti.generalizedAlpha.spectralRadius = settings.spectral_radius
+    index2 = settings.solver == "TrapezoidalIndex2"
+    ti.generalizedAlpha.useNewmark = index2
+    ti.generalizedAlpha.useIndex2Constraints = index2
+    ti.newton.useModifiedNewton = settings.modified_newton
+    ti.newton.relativeTolerance = settings.newton_relative_tolerance
+    ti.newton.absoluteTolerance = settings.newton_absolute_tolerance
+    ti.newton.maxIterations = settings.newton_max_iterations
+    ti.discontinuous.maxIterations = settings.discontinuous_max_iterations
+    ti.discontinuous.iterationTolerance = settings.discontinuous_tolerance
+    ti.discontinuous.useRecommendedStepSize = settings.recommended_step
+    full_pivot = closed_loop and settings.closed_loop_full_pivot
+    solver = "EigenDense" if full_pivot else settings.linear_solver
+    s.linearSolver.solverType = getattr(exu.LinearSolverType, solver)
+    s.linearSolver.ignoreSingularJacobian = full_pivot or settings.ignore_singular_jacobian
+    s.solution.file.write = False
+    s.solution.file.writeInitialValues = False
+    s.solution.sensors.active = False
+    s.solution.restart.write = False
+    s.show.computationTime = False
+    s.show.statistics = False
+    return s
+
+
+class Runner:
+    """The step loop of one run: recording into arrays and the guards (model units)."""
+
+    def __init__(self, scene: Scene, built: BuiltSystem, config: ExudynSettings, steps: int,
+                 record_every: int):
+        self.scene = scene
+        self.built = built
+        self.config = config
+        self.steps = steps
+        self.dt = built.time_step
+        self.recorder = SampleRecorder(len(scene.bodies), len(scene.all_contacts), steps,
+                                       record_every)
+        # Reduced steps make Exudyn's time leave the grid: a sample is the first step end at
+        # or after its time.
+        self.record_times = np.asarray(self.recorder.schedule, dtype=float) * self.dt
+        self.min_normal_force = 0.0
+        self.solver_steps = 0
+        self.stepping_seconds = 0.0
+        self.record_seconds = 0.0
+        self.problem: str | None = None
+        self.guard_notes: list[str] = []
+        self.captured_stdout = ""
+        self.error_string = ""
+        self.mass = np.array([b.mass for b in scene.bodies])
+        self.inertia = np.array([np.asarray(b.inertia, dtype=float) for b in scene.bodies])
+        self.movable = np.array([b.motion is not Motion.FIXED for b in scene.bodies])
+        self.gravity = np.asarray(scene.gravity, dtype=float)
+        self._springs = [(load, scene.body_index(load.body_a), scene.body_index(load.body_b))
+                         for load in scene.loads if isinstance(load, LinearSpringDamper)]
+        self._energy_guard = self._energy_guard_applies()
+        self._size_energy = self._size_energy_scale()
+        self.energy_initial = math.nan
+        self.energy_max_gain = 0.0
+        self._kinetic_max = 0.0
+        self._newton_count = 0
+        self._last_newton = 0
+        self._discontinuous_failures = 0
+        self.discontinuous_failures_total = 0
+        self._steps_since_check = 0
+        self._solver = None
+        self._last_time = 0.0
+        self._law_cache: tuple[bytes, np.ndarray] | None = None
+
+    # ------------------------------------------------------------------ guards
+    def _energy_guard_applies(self) -> bool:
+        kinds = {e.kind for e in self.scene.expectations}
+        if not kinds & set(ENERGY_EXPECTATIONS):
+            self.guard_notes.append("energy guard off: no energy expectation")
+            return False
+        work = sorted(set(WORK_FEATURES) & self.scene.features)
+        if work:
+            self.guard_notes.append(f"energy guard off: {', '.join(work)} not counted")
+            return False
+        self.guard_notes.append(
+            f"energy guard on: stops when energy exceeds its initial value by more than "
+            f"{self.config.energy_gain_tolerance:g} x the energy scale, checked every "
+            f"{self.config.guard_interval} steps and at every sample")
+        return True
+
+    def _size_energy_scale(self) -> float:
+        """sum(m |g|) over the moving bodies x the largest shape dimension [M L^2/T^2]."""
+        g = float(np.linalg.norm(self.gravity))
+        return float(np.sum(self.mass[self.movable])) * g * largest_shape_dimension(self.scene)
+
+    # ------------------------------------------------------------------ state
+    def state(self):
+        """Origins (nb, 3), quaternions (nb, 4), rotations (nb, 3, 3), centre-of-mass
+        velocities (nb, 3) and body-axis angular velocities (nb, 3) of the current state."""
+        data = self.built.mbs.systemData
+        q = np.asarray(data.GetODE2Coordinates())
+        q_t = np.asarray(data.GetODE2Coordinates_t())
+        bodies = self.built.bodies
+        position, quaternion = bodies.poses(q)
+        rotation = quat_to_matrix_batch(quaternion)
+        velocity, omega = bodies.velocities(q, q_t, rotation)
+        return position, quaternion, rotation, velocity, omega
+
+    def energy(self, state=None) -> tuple[float, float]:
+        """(total, kinetic) energy as harness.metrics.energy counts it (model units)."""
+        position, _, rotation, velocity, omega = state or self.state()
+        m = self.movable
+        kinetic = 0.5 * np.sum(self.mass[m] * np.sum(velocity[m] ** 2, axis=1))
+        kinetic += 0.5 * np.einsum("bi,bij,bj->", omega[m], self.inertia[m], omega[m])
+        com = position + np.einsum("bij,bj->bi", rotation, self.built.bodies.com)
+        potential = -np.sum(self.mass[m] * (com[m] @ self.gravity))
+        springs = 0.0
+        for load, a, b in self._springs:
+            pa = position[a] + rotation[a] @ np.asarray(load.point_a)
+            pb = position[b] + rotation[b] @ np.asarray(load.point_b)
+            stretch = np.linalg.norm(pb - pa) - load.rest_length
+            springs += load.preload * stretch + 0.5 * load.stiffness * stretch**2
+        return float(kinetic + potential + springs), float(kinetic)
+
+    def _check_energy(self, t: float, state) -> str | None:
+        total, kinetic = self.energy(state)
+        self._kinetic_max = max(self._kinetic_max, kinetic)
+        gain = total - self.energy_initial
+        scale = max(self._kinetic_max, self._size_energy, 1e-300)
+        self.energy_max_gain = max(self.energy_max_gain, gain / scale)
+        if gain > self.config.energy_gain_tolerance * scale:
+            return (f"energy gain {gain:.4g} (model units) = {gain / scale:.3g} x the energy "
+                    f"scale at t = {t:.6g}: above the tolerance "
+                    f"{self.config.energy_gain_tolerance:g} on a scene whose energy may only "
+                    "decrease")
+        return None
+
+    # ------------------------------------------------------------------ read-out
+    def contact_forces(self) -> tuple[np.ndarray, np.ndarray, int]:
+        """Per scene pair: normal force sum (npair,) and total force on body B (npair, 3,
+        world) of the current state; and the number of connectors in contact (gap < 0, as
+        stored by Exudyn's last PostNewton)."""
+        exu = load_exudyn()
+        mbs = self.built.mbs
+        npair = len(self.scene.all_contacts)
+        normal = np.zeros(npair)
+        total = np.zeros((npair, 3))
+        if not self.built.connectors:
+            return normal, total, 0
+        gaps = np.asarray(mbs.systemData.GetDataCoordinates())
+        active = 0
+        for ref in self.built.connectors:
+            if gaps[ref.data_index] >= 0.0:
+                continue
+            force = np.asarray(mbs.GetObjectOutput(ref.object, exu.OutputVariableType.Force))
+            if not force.any():
+                continue
+            n0 = np.asarray(mbs.GetObjectOutput(ref.object,
+                                                exu.OutputVariableType.Director1))
+            active += 1
+            normal[ref.pair] += -float(force @ n0)  # Force acts on the sphere; n0 points away
+            total[ref.pair] += ref.sign * force
+        return normal, total, active
+
+    @property
+    def count(self) -> int:
+        """Samples stored so far."""
+        return self.recorder.count
+
+    def store(self, t: float, state, with_contacts: bool = True) -> None:
+        """Store the current state as the next sample, with the contact forces and the solver
+        statistics since the previous sample (``with_contacts``; off for the initial state)."""
+        position, quaternion, _, velocity, omega = state
+        contacts = residual = None
+        solver = self._solver
+        if with_contacts:
+            contacts = self.contact_forces()
+            self.min_normal_force = min(self.min_normal_force, float(np.min(contacts[0],
+                                                                            initial=0.0)))
+            if solver is not None:
+                count = int(solver.it.newtonStepsCount)
+                self.recorder.accumulate(count - self._last_newton,
+                                         self._discontinuous_failures == 0)
+                self._last_newton = count
+                self._discontinuous_failures = 0
+                residual = float(solver.conv.residual)
+        self.recorder.store(t, position, quaternion, velocity, omega, contacts, residual)
+
+    # ------------------------------------------------------------------ user functions
+    def _pre_step(self, mbs, t: float) -> bool:
+        laws = self.built.law_forces
+        position, _, rotation, _, _ = self.state()
+        com = position + np.einsum("bij,bj->bi", rotation, self.built.bodies.com)
+        wrench = laws.wrenches(com, rotation, t)
+        for b, force, torque in self.built.law_loads:
+            mbs.SetLoadParameter(force, "loadVector", wrench[b, :3].tolist())
+            mbs.SetLoadParameter(torque, "loadVector", wrench[b, 3:].tolist())
+        return True
+
+    def _law_wrench(self, mbs, t: float) -> np.ndarray:
+        """Law wrenches at the current Newton iterate, cached per state vector."""
+        q = np.asarray(mbs.systemData.GetODE2Coordinates())
+        key = q.tobytes()
+        if self._law_cache is None or self._law_cache[0] != key:
+            position, quaternion = self.built.bodies.poses(q)
+            rotation = quat_to_matrix_batch(quaternion)
+            com = position + np.einsum("bij,bj->bi", rotation, self.built.bodies.com)
+            self._law_cache = (key, self.built.law_forces.wrenches(com, rotation, t))
+        return self._law_cache[1]
+
+    def _install_implicit_laws(self) -> None:
+        mbs = self.built.mbs
+        for b, force, torque in self.built.law_loads:
+            def force_function(mbs, t, load, b=b):
+                return self._law_wrench(mbs, t)[b, :3].tolist()
+
+            def torque_function(mbs, t, load, b=b):
+                return self._law_wrench(mbs, t)[b, 3:].tolist()
+
+            mbs.SetLoadParameter(force, "loadVectorUserFunction", force_function)
+            mbs.SetLoadParameter(torque, "loadVectorUserFunction", torque_function)
+            self.built.keep_alive += [force_function, torque_function]
+
+    def _post_step(self, mbs, t: float) -> bool:
+        if t <= self._last_time:  # the call of SolveSteps at the start of each nominal step
+            return True
+        self._last_time = t
+        tick = time.perf_counter()
+        self.solver_steps += 1
+        solver = self._solver
+        if solver is not None and not solver.conv.discontinuousIterationSuccessful:
+            self._discontinuous_failures += 1
+            self.discontinuous_failures_total += 1
+        data = mbs.systemData
+        q = np.asarray(data.GetODE2Coordinates())
+        problem = None
+        if not (np.isfinite(q).all() and np.isfinite(np.asarray(data.GetODE2Coordinates_t()))
+                .all()):
+            problem = f"non-finite state at t = {t:.6g}"
+        if self.built.law_forces is not None:
+            _, quaternion = self.built.bodies.poses(q)
+            self.built.law_forces.remember(quat_to_matrix_batch(quaternion))
+        recording = (self.count < len(self.record_times)
+                     and t >= self.record_times[self.count] - 1e-6 * self.dt)
+        self._steps_since_check += 1
+        checking = self._energy_guard and self._steps_since_check >= self.config.guard_interval
+        if recording or checking or problem is not None:
+            state = self.state()
+            if self._energy_guard and problem is None:
+                self._steps_since_check = 0
+                problem = self._check_energy(t, state)
+            if (recording or problem is not None) and not self.recorder.is_full:
+                self.store(t, state)
+        self.record_seconds += time.perf_counter() - tick
+        if problem is not None:
+            self.problem = problem
+            return False
+        return True
+
+    # ------------------------------------------------------------------ loop
+    def run(self) -> tuple[RunStatus, str]:
+        exu = load_exudyn()
+        mbs = self.built.mbs
+        closed_loop = "closed_loop" in self.scene.features
+        s = simulation_settings(self.config, self.dt, self.steps, closed_loop)
+        if closed_loop and self.config.closed_loop_full_pivot:
+            self.guard_notes.append("closed loop: EigenDense full-pivot LU with "
+                                    "ignoreSingularJacobian (redundant constraints)")
+        state = self.state()
+        self.energy_initial, self._kinetic_max = self.energy(state)
+        self.store(0.0, state, with_contacts=False)
+        mbs.SetPostStepUserFunction(self._post_step)
+        if self.built.law_forces is not None:
+            if self.config.law_loads == "explicit":
+                mbs.SetPreStepUserFunction(self._pre_step)
+            else:
+                self._install_implicit_laws()
+        solver = exu.MainSolverImplicitSecondOrder()
+        self._solver = solver
+        previous = exu.config.printToConsole
+        exu.config.printToConsole = False
+        buffer = io.StringIO()
+        status, message = RunStatus.OK, ""
+        tick = time.perf_counter()
+        try:
+            with contextlib.redirect_stdout(buffer):
+                if not solver.InitializeSolver(mbs, s):
+                    raise exu.SolverError("InitializeSolver failed: "
+                                          + solver.GetErrorString())
+                self._last_newton = int(solver.it.newtonStepsCount)
+                success = True
+                for step in range(1, self.steps + 1):
+                    solver.it.endTime = step * self.dt
+                    success = solver.SolveSteps(mbs, s)
+                    if not success or self.problem is not None:
+                        break
+                solver.FinalizeSolver(mbs, s)
+            if self.problem is not None:
+                status, message = RunStatus.DIVERGED, self.problem
+            elif not success:
+                self.error_string = solver.GetErrorString()
+                status = RunStatus.DIVERGED
+                message = (f"Exudyn solver failed at t = {mbs.systemData.GetTime():.6g}: "
+                           f"{self.error_string or 'SolveSteps returned False'}"
+                           + self._failure_flags(solver))
+        except exu.ExudynError as error:  # SolverError and the other Exudyn errors
+            self.error_string = solver.GetErrorString()
+            status = RunStatus.DIVERGED if isinstance(error, exu.SolverError) \
+                else RunStatus.CRASHED
+            message = (f"Exudyn {type(error).__name__} at t = {mbs.systemData.GetTime():.6g}: "
+                       f"{error}" + (f" ({self.error_string})" if self.error_string else "")
+                       + self._failure_flags(solver))
+        except Exception as error:  # a Python user function or the adapter itself
+            status = RunStatus.CRASHED
+            message = f"{type(error).__name__}: {error}"
+        finally:
+            exu.config.printToConsole = previous
+            self.captured_stdout = buffer.getvalue()
+        self.stepping_seconds = time.perf_counter() - tick - self.record_seconds
+        if status is not RunStatus.OK:
+            # keep the state where it stopped as the last sample
+            recorder = self.recorder
+            if not recorder.is_full and recorder.times[recorder.count - 1] < \
+                    mbs.systemData.GetTime():
+                self.store(mbs.systemData.GetTime(), self.state())
+            logger.info("%s: stopped: %s", self.scene.name, message)
+        return status, message
+
+    @staticmethod
+    def _failure_flags(solver) -> str:
+        conv = solver.conv
+        flags = [name for name in ("newtonSolutionDiverged", "stepReductionFailed",
+                                   "linearSolverFailed", "massMatrixNotInvertible")
+                 if getattr(conv, name)]
+        return f" [{', '.join(flags)}]" if flags else ""

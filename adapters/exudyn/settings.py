@@ -1,0 +1,303 @@
+"""Exudyn presets, run options, and the contact-parameter rules (stiffness, restitution).
+
+Pure Python (no ``exudyn`` import): capabilities and option errors are stated without building a
+system.
+
+Exudyn's per-pair contact connectors (``ObjectContactSphereSphere``,
+``ObjectContactSphereTriangle``) are penalty springs with a restitution model and regularised
+Coulomb friction:
+
+- normal force ``k delta^n + lambda delta^n v_n + d v_n`` with the impact model's ``lambda``;
+  the Gonthier / Carvalho-Martins model (``impactModel = 2``) reproduces Newton's e (measured:
+  first-apex error -1.7 % ... +4 % for e 0.2-0.9), Hunt-Crossley (1) does not (+2 % at e 0.9,
+  +75 % at e 0.5, +500 % at e 0.2) and the linear model (0) only damps with ``d``;
+- ``lambda = k f(e) / max(v_min, v_impact)``: a contact that starts at rest has no impact
+  velocity and, with ``v_min = 0`` (Exudyn's default), no damping at all;
+- the restitution coefficient must be > 0: e = 0 pairs get ``plastic_restitution``;
+- friction ``mu N v_t / v_reg`` below the regularisation velocity ``v_reg``
+  (``frictionProportionalZone``): a body that should stick on an incline of angle theta creeps
+  at ``v_reg tan(theta) / mu`` (measured exactly when the normal contact is damped);
+- Exudyn's default stiffness is 0 (no contact at all): the adapter derives one (see
+  :func:`contact_stiffness`).
+
+Physical option values are stated in SI (``*_velocity`` in m/s) and converted to the model's
+units by the builder; ratios and counts are dimensionless.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+#: Named presets; each is a separate engine variant ``exudyn[<preset>]`` in results.
+PRESETS: dict[str, dict] = {
+    # Exudyn as it comes: generalized-alpha (spectral radius 0.9, modified Newton, adaptive
+    # step reduction), Gonthier impact model, v_reg = 1e-3 m/s, no minimum impact velocity;
+    # only the stiffness is the adapter's (Exudyn's default 0 is no contact).
+    "default": {},
+    # From the measurements in NOTES.md: v_reg 1e-7 m/s (creep 0.06 um/s predicted on the
+    # 10 degree incline, 0.015-0.05 um/s measured), resting contacts damped through a minimum
+    # impact velocity of 0.01 m/s (without it the undamped contact springs let the box ratchet
+    # down the slope and the solver needs 15-18x more steps), stiffer contacts (period 4 steps:
+    # 2 steps fail) computed from the scene's comfortable step (one model for every dt: the
+    # run's dt = 1e-4 made k 100x stiffer and the incline and the ball fail), and e = 0 pairs
+    # at e = 0.05 (at 1e-3 the undamped-then-overdamped Gonthier force pulls: -97 N in the
+    # clearance pendulum; Exudyn does not clip the normal force at zero).
+    "tuned": {
+        "friction_regularisation_velocity": 1e-7,
+        "minimum_impact_velocity": 0.01,
+        "contact_period_steps": 4.0,
+        "stiffness_time_step": "scene",
+        "plastic_restitution": 0.05,
+    },
+}
+
+SOLVERS = ("GeneralizedAlpha", "TrapezoidalIndex2")
+LINEAR_SOLVERS = ("EXUdense", "EigenSparse", "EigenDense")
+RING_JOURNAL_MODELS = ("hollow_sphere", "in_plane", "facets")
+LAW_LOAD_MODES = ("explicit", "implicit")
+UNIT_CHOICES = ("scene", "SI")
+
+
+@dataclass(frozen=True)
+class ExudynSettings:
+    """Every option of an Exudyn run.
+
+    Attributes
+    ----------
+    solver : {'GeneralizedAlpha', 'TrapezoidalIndex2'}
+        Implicit second-order solver (``exu.DynamicSolverType``).
+    spectral_radius : float
+        Generalized-alpha spectral radius at infinity, in [0, 1] (Exudyn: 0.9).
+    adaptive_step : bool
+        Let Exudyn reduce the step when Newton or the discontinuous iteration fails, and to hit
+        contact events (``recommendedStepSize``); the nominal step is restored afterwards.
+    minimum_step_fraction : float
+        Smallest reduced step as a fraction of the nominal one.
+    modified_newton : bool
+        Exudyn's modified Newton (Jacobian kept between iterations; its default).
+    newton_relative_tolerance, newton_absolute_tolerance : float
+        Newton tolerances (Exudyn: 1e-8, 1e-10).
+    newton_max_iterations : int
+        Newton iterations per step before the step counts as failed (Exudyn: 25).
+    discontinuous_max_iterations : int
+        Contact/friction switching iterations per step (Exudyn: 5).
+    discontinuous_tolerance : float
+        Force error accepted by the switching iteration (Exudyn: 1).
+    recommended_step : bool
+        Let contact connectors shorten a step so that it ends at the contact instant
+        (Exudyn's ``discontinuous.useRecommendedStepSize``; needs ``adaptive_step``).
+    linear_solver : {'EXUdense', 'EigenSparse'}
+    ignore_singular_jacobian : bool
+        Let the linear solver pass redundant constraints (Exudyn: only with 'EigenDense',
+        whose full-pivot LU then solves in the least-squares sense).
+    closed_loop_full_pivot : bool
+        On scenes whose joints close a loop (a planar loop in 3D has redundant constraints:
+        EXUdense stops with "matrix is not factorized"), use 'EigenDense' with
+        ``ignore_singular_jacobian`` whatever the two options above say.
+    impact_model : {0, 1, 2}
+        Connector impact model: 0 linear, 1 Hunt-Crossley, 2 Gonthier/Carvalho-Martins.
+    contact_stiffness : float or None
+        Stiffness of every connector [force/length^n, model units]; None: the rule of
+        :func:`contact_stiffness` with ``contact_period_steps``.
+    contact_period_steps : float
+        Steps per period of a connector's spring on the pair's reduced mass (rule above).
+    stiffness_time_step : {'run', 'scene'}
+        The step of that rule: the run's (the stiffness follows dt: a step sweep changes the
+        model) or the scene's comfortable ``time_step`` (one model for every dt).
+    contact_stiffness_exponent : float
+        Exponent n of the normal force law (1: linear, 1.5: Hertz).
+    contact_damping_ratio : float
+        Extra linear damping d = 2 zeta sqrt(k m) of every connector (0: none; it adds to the
+        impact model and lowers e).
+    minimum_impact_velocity : float
+        Lower bound of the impact velocity in the impact model [m/s]; > 0 damps resting
+        contacts.
+    friction_regularisation_velocity : float
+        Exudyn's ``frictionProportionalZone`` [m/s].
+    plastic_restitution : float
+        Restitution given to pairs with e = 0 (Exudyn requires e > 0).
+    ring_spheres : int
+        Spheres per full circle along a ring, arc or circle rim.
+    ring_sphere_radius : float
+        Radius of those spheres relative to the ring radius (capped so that the compensated
+        partner stays positive).
+    journal_facets : int
+        Flat facets per full circle of a cylinder or bore rebuilt as a prism.
+    facet_window : float
+        Half angle [rad] of the facets of a cylinder or bore a ring sphere is paired with,
+        around the facet facing it at t = 0 (pi: all facets).
+    journal_spheres : int
+        Spheres along the axis of a journal inside a bore.
+    ring_journal : {'hollow_sphere', 'in_plane', 'facets'}
+        A full ring around a journal: one sphere-in-hollow-sphere connector (exact in the
+        ring's plane), or as the other ring-cylinder and ring-bore pairs: 'in_plane' (each
+        ring sphere against a sphere on the partner's axis at its level: exact for motion
+        normal to the axis) or 'facets' (ring spheres against the partner as a prism of
+        facets). 'hollow_sphere' uses 'in_plane' for the other pairs.
+    corner_sphere_radius : float
+        Radius of a box corner's sphere relative to the box's smallest half extent (the
+        partner face is moved back by it, so the gap stays the corner's; a corner deeper than
+        this passes through).
+    plane_size : float
+        Half size of the quad standing in for an unbounded plane, relative to the scene size.
+    disc_segments : int
+        Triangles of the fan standing in for a disc face.
+    law_loads : {'explicit', 'implicit'}
+        C-60 law loads evaluated once per step at its start (explicit, one step lag) or in
+        every Newton residual through Python load user functions (implicit).
+    internal_units : {'scene', 'SI'}
+        Units of the Exudyn model: the scene's own or SI.
+    energy_gain_tolerance : float
+        Energy gain beyond this fraction of the energy scale stops the run as diverged on
+        scenes whose energy may not grow.
+    guard_interval : int
+        Steps between energy checks.
+    """
+
+    solver: str = "GeneralizedAlpha"
+    spectral_radius: float = 0.9
+    adaptive_step: bool = True
+    minimum_step_fraction: float = 1e-5
+    modified_newton: bool = True
+    newton_relative_tolerance: float = 1e-8
+    newton_absolute_tolerance: float = 1e-10
+    newton_max_iterations: int = 25
+    discontinuous_max_iterations: int = 5
+    discontinuous_tolerance: float = 1.0
+    recommended_step: bool = True
+    linear_solver: str = "EXUdense"
+    ignore_singular_jacobian: bool = False
+    closed_loop_full_pivot: bool = True
+    impact_model: int = 2
+    contact_stiffness: float | None = None
+    contact_period_steps: float = 10.0
+    stiffness_time_step: str = "run"
+    contact_stiffness_exponent: float = 1.0
+    contact_damping_ratio: float = 0.0
+    minimum_impact_velocity: float = 0.0
+    friction_regularisation_velocity: float = 1e-3
+    plastic_restitution: float = 1e-3
+    ring_spheres: int = 32
+    ring_sphere_radius: float = 0.05
+    journal_facets: int = 32
+    facet_window: float = math.pi / 2
+    journal_spheres: int = 3
+    ring_journal: str = "hollow_sphere"
+    corner_sphere_radius: float = 0.1
+    plane_size: float = 100.0
+    disc_segments: int = 16
+    law_loads: str = "explicit"
+    internal_units: str = "scene"
+    energy_gain_tolerance: float = 0.1
+    guard_interval: int = 10
+
+    def __post_init__(self) -> None:
+        choices = {"solver": SOLVERS, "linear_solver": LINEAR_SOLVERS,
+                   "ring_journal": RING_JOURNAL_MODELS, "law_loads": LAW_LOAD_MODES,
+                   "internal_units": UNIT_CHOICES, "impact_model": (0, 1, 2),
+                   "stiffness_time_step": ("run", "scene")}
+        for name, allowed in choices.items():
+            if getattr(self, name) not in allowed:
+                _fail(name, getattr(self, name), f"must be one of {allowed}")
+        for name in ("adaptive_step", "modified_newton", "ignore_singular_jacobian",
+                     "closed_loop_full_pivot", "recommended_step"):
+            if not isinstance(getattr(self, name), bool):
+                _fail(name, getattr(self, name), "must be true or false")
+        integers = {"newton_max_iterations": 1, "discontinuous_max_iterations": 1,
+                    "ring_spheres": 3, "journal_facets": 3, "journal_spheres": 1,
+                    "disc_segments": 3, "guard_interval": 1}
+        for name, low in integers.items():
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < low:
+                _fail(name, value, f"must be an integer >= {low}")
+        positive = ("minimum_step_fraction", "newton_relative_tolerance",
+                    "newton_absolute_tolerance", "discontinuous_tolerance",
+                    "contact_period_steps", "contact_stiffness_exponent",
+                    "friction_regularisation_velocity", "plastic_restitution",
+                    "ring_sphere_radius", "facet_window", "corner_sphere_radius", "plane_size",
+                    "energy_gain_tolerance")
+        for name in positive:
+            value = getattr(self, name)
+            if not _is_real(value) or not value > 0 or not math.isfinite(value):
+                _fail(name, value, "must be a finite number > 0")
+        for name in ("contact_damping_ratio", "minimum_impact_velocity"):
+            value = getattr(self, name)
+            if not _is_real(value) or not value >= 0 or not math.isfinite(value):
+                _fail(name, value, "must be a finite number >= 0")
+        if not _is_real(self.spectral_radius) or not 0.0 <= self.spectral_radius <= 1.0:
+            _fail("spectral_radius", self.spectral_radius, "must be in [0, 1]")
+        if not self.plastic_restitution <= 1.0:
+            _fail("plastic_restitution", self.plastic_restitution, "must be in (0, 1]")
+        if not self.minimum_step_fraction < 1.0:
+            _fail("minimum_step_fraction", self.minimum_step_fraction, "must be < 1")
+        if self.facet_window > math.pi:
+            _fail("facet_window", self.facet_window, "must be <= pi")
+        if self.contact_stiffness is not None and (
+                not _is_real(self.contact_stiffness) or not self.contact_stiffness > 0
+                or not math.isfinite(self.contact_stiffness)):
+            _fail("contact_stiffness", self.contact_stiffness,
+                  "must be a finite number > 0 (or None for the rule)")
+
+    def as_dict(self) -> dict:
+        """Plain-dict form for trajectory metadata."""
+        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+
+
+def _is_real(value) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool)
+
+
+def _fail(name: str, value, reason: str) -> None:
+    raise ValueError(f"exudyn option {name}={value!r}: {reason}")
+
+
+OPTION_NAMES = tuple(f.name for f in dataclasses.fields(ExudynSettings))
+
+
+def resolve_settings(preset: str, options: dict | None = None) -> ExudynSettings:
+    """Values of the preset (a key of :data:`PRESETS`) overridden by ``options`` (fields of
+    :class:`ExudynSettings`; the engine checks their names, the dataclass their values:
+    ValueError naming the option and value at fault)."""
+    return ExudynSettings(**{**PRESETS[preset], **dict(options or {})})
+
+
+# ---------------------------------------------------------------------------- contact rules
+def contact_stiffness(settings: ExudynSettings, reduced_mass: float, time_step: float) -> float:
+    """Stiffness of one connector [force/length, model units].
+
+    Rule (when ``contact_stiffness`` is None): the connector's spring on the pair's reduced
+    mass m (a fixed partner counts as infinitely heavy) has a period of
+    ``contact_period_steps`` steps: ``k = m (2 pi / (n dt))^2``. Per connector: a box resting
+    on its 4 corners is 4 such springs in parallel (its normal period is n/2 steps).
+
+    Parameters
+    ----------
+    reduced_mass : float
+        m_a m_b / (m_a + m_b) [M], or the free body's mass against a fixed one.
+    time_step : float
+        Nominal step [T].
+    """
+    if settings.contact_stiffness is not None:
+        return settings.contact_stiffness
+    omega = 2.0 * math.pi / (settings.contact_period_steps * time_step)
+    return reduced_mass * omega**2
+
+
+def contact_damping(settings: ExudynSettings, stiffness: float, reduced_mass: float) -> float:
+    """Extra linear damping d = 2 zeta sqrt(k m) of one connector [force time/length]."""
+    return 2.0 * settings.contact_damping_ratio * math.sqrt(stiffness * reduced_mass)
+
+
+def exudyn_restitution(restitution: float, settings: ExudynSettings) -> float:
+    """Restitution given to Exudyn: e itself, or ``plastic_restitution`` for e = 0 (Exudyn
+    requires e > 0; measured: e = 1e-3 leaves a 1 kg ball dropped 1 m at rest)."""
+    if not 0.0 <= restitution <= 1.0:
+        raise ValueError(f"restitution must be in [0, 1], got {restitution!r}")
+    return restitution if restitution > 0.0 else settings.plastic_restitution
+
+
+def incline_creep(settings: ExudynSettings, angle: float, friction: float) -> float:
+    """Creep velocity of a body that should stick on an incline [m/s]: v_reg tan(theta)/mu."""
+    return settings.friction_regularisation_velocity * math.tan(angle) / friction

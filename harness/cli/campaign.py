@@ -1,0 +1,127 @@
+"""``clearbench campaign``: tolerance studies (Monte Carlo over scene parameters) on Dask.
+
+- ``clearbench campaign run FILE|NAME``: run every sample not yet in the store (resumable);
+- ``clearbench campaign report FILE|NAME [--with FILE|NAME ...]``: statistics, histograms,
+  convergence and sensitivities as Markdown, HTML, JSON and CSV;
+- ``clearbench campaign status FILE|NAME``: how many samples are recorded, by status.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+from clearbench.harness.cli.common import UserError, add_store_option, open_store
+from clearbench.harness.studies.campaign.definition import (
+    SHIPPED,
+    CampaignError,
+    load_campaign,
+    with_overrides,
+)
+from clearbench.harness.studies.campaign.execution import plan_samples, run_campaign
+from clearbench.harness.studies.campaign.report import write_campaign_report
+
+#: Where reports go by default.
+DEFAULT_OUT = "reports/campaigns"
+
+
+def register(subparsers) -> None:
+    """Add the ``campaign`` command and its sub-commands."""
+    parser = subparsers.add_parser(
+        "campaign", help="tolerance studies: Monte Carlo / quasi-Monte Carlo over scene "
+        "parameters, resumable, on Dask",
+        description="A tolerance campaign draws scene parameters (e.g. the C-60's joint "
+        "clearances) from their laws, runs one isolated run per sample into the results "
+        "store, and summarises the outputs with capability indices. Shipped campaigns: "
+        + ", ".join(SHIPPED) + ".")
+    commands = parser.add_subparsers(dest="campaign_command", metavar="SUBCOMMAND")
+    commands.required = True
+
+    run = commands.add_parser("run", help="run the samples not yet in the store")
+    _add_definition_options(run)
+    run.add_argument("--scheduler", default=os.environ.get("CLEARBENCH_DASK_SCHEDULER"),
+                     metavar="ADDRESS", help="a running Dask scheduler (tcp://host:8786); "
+                     "default: a LocalCluster on this machine ($CLEARBENCH_DASK_SCHEDULER)")
+    run.add_argument("--workers", type=int, default=None,
+                     help="LocalCluster worker processes (default: usable cores)")
+    run.add_argument("--no-progress", action="store_true", help="no progress bar")
+    run.set_defaults(handler=_run)
+
+    report = commands.add_parser("report", help="write the campaign's report section")
+    _add_definition_options(report)
+    report.add_argument("--with", dest="companions", action="append", default=[],
+                        metavar="FILE|NAME", help="another campaign of the same study (another "
+                        "design), drawn in the convergence figures (repeatable)")
+    report.add_argument("--out", default=DEFAULT_OUT, metavar="DIR",
+                        help=f"output folder (default {DEFAULT_OUT})")
+    report.set_defaults(handler=_report)
+
+    status = commands.add_parser("status", help="recorded samples by status")
+    _add_definition_options(status)
+    status.set_defaults(handler=_status)
+
+
+def _add_definition_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("campaign", metavar="FILE|NAME",
+                        help="campaign TOML file, or a shipped campaign: " + ", ".join(SHIPPED))
+    parser.add_argument("--samples", type=int, default=None,
+                        help="number of samples (overrides the file)")
+    parser.add_argument("--engine", "-e", default=None, metavar="ENGINE[PRESET]",
+                        help="engine (overrides the file)")
+    add_store_option(parser)
+
+
+def _definition(args: argparse.Namespace, text: str | None = None):
+    try:
+        definition = load_campaign(text or args.campaign)
+        return with_overrides(definition, samples=args.samples, engine=args.engine)
+    except CampaignError as error:
+        raise UserError(f"{text or args.campaign}: {error}") from None
+
+
+def _run(args: argparse.Namespace) -> int:
+    definition = _definition(args)
+    if args.workers is not None and args.workers < 1:
+        raise UserError(f"--workers {args.workers}: must be >= 1")
+    workers = args.workers or max(1, len(os.sched_getaffinity(0)))
+    store = open_store(args)
+    try:
+        outcome = run_campaign(definition, store, scheduler=args.scheduler, workers=workers,
+                               progress=not args.no_progress and sys.stderr.isatty())
+    except CampaignError as error:
+        raise UserError(f"{args.campaign}: {error}") from None
+    print(f"{definition.name}: {outcome.planned} samples planned, {outcome.already} already in "
+          f"{store.directory}, {outcome.recorded} run now {outcome.statuses or ''}")
+    return 0
+
+
+def _report(args: argparse.Namespace) -> int:
+    definition = _definition(args)
+    companions = tuple(_definition(args, text) for text in args.companions)
+    store = open_store(args, create=False)
+    try:
+        summary = write_campaign_report(definition, store, Path(args.out), companions)
+    except CampaignError as error:
+        raise UserError(f"{args.campaign}: {error}") from None
+    print(f"{definition.name}: {summary['statuses']}; report in {args.out}/"
+          f"{definition.name}.md and .html")
+    return 0
+
+
+def _status(args: argparse.Namespace) -> int:
+    definition = _definition(args)
+    store = open_store(args, create=False)
+    try:
+        samples = plan_samples(definition)
+    except CampaignError as error:
+        raise UserError(f"{args.campaign}: {error}") from None
+    counts: dict[str, int] = {}
+    for sample in samples:
+        row = store.get(sample.spec.key)
+        status = row["status"] if row else "pending"
+        counts[status] = counts.get(status, 0) + 1
+    print(f"{definition.name}: {len(samples)} samples: "
+          + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())))
+    return 0

@@ -1,0 +1,174 @@
+"""Error of an engine against the physics expectations of the analytic scenes, as Markdown
+tables (``clearbench bench mujoco-table``).
+
+Every figure comes from :func:`clearbench.harness.measure.expectation_figures.evaluate`, the
+evaluator every engine is judged by, so a MuJoCo column and a reference-solver column are computed
+by the same code. This module only chooses which figures to show and in which display unit.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from clearbench.adapters.base import Engine, RunSettings
+from clearbench.adapters.trajectory import RunStatus
+from clearbench.harness.measure.expectation_figures import evaluate
+from clearbench.scenarios.library import get_scene, scene_names
+from clearbench.scenarios.scene import Scene
+
+
+@dataclass(frozen=True)
+class Figure:
+    """A figure of an expectation shown in the table: key in the evaluator's figures, label,
+    display factor and unit (factor applied to values in SI scene units)."""
+
+    key: str
+    label: str
+    factor: float = 1.0
+    unit: str = ""
+
+
+#: Figures shown per expectation kind (the evaluator computes more).
+TABLE_FIGURES: dict[str, tuple[Figure, ...]] = {
+    "bounce_apex": (Figure("apex_1_relative_error", "1st apex height, relative error", 100, "%"),
+                    Figure("apex_max_relative_error", "worst apex height, relative error",
+                           100, "%"),
+                    Figure("height_after_rest", "height after t_inf", 1e3, "mm")),
+    "incline_stick": (Figure("displacement", "creep below the friction angle", 1e6, "um"),),
+    "incline_slide": (Figure("acceleration_relative_error", "sliding acceleration, relative "
+                             "error", 100, "%"),),
+    "sliding_stop": (Figure("stop_distance_error", "stop distance error", 1e3, "mm"),),
+    "rolling_transition": (Figure("final_speed_relative_error", "rolling speed, relative error",
+                                  100, "%"),),
+    "rocking_ratio": (Figure("ratio_relative_error", "impact velocity ratio, relative error",
+                             100, "%"),),
+    "pendulum": (Figure("energy_drift", "energy drift / (m g d)", 100, "%"),
+                 Figure("period_relative_error", "period, relative error", 100, "%")),
+    "torque_free": (Figure("angular_momentum_drift", "angular momentum drift / L0", 100,
+                           "%"),),
+    "slider_crank": (Figure("slider_position_max_error", "slider position error", 1e6, "um"),),
+    "approaches_ideal": (Figure("clearance_excess", "clearance excess", 1e6, "um"),),
+    "no_penetration": (Figure("penetration_max", "penetration", 1e3, "mm"),),
+    "energy_non_increasing": (Figure("energy_growth_relative", "energy growth / energy scale",
+                                     100, "%"),),
+}
+
+#: Scenes of the MuJoCo table: the analytic library plus the clearance pendulum.
+DEFAULT_SCENES = tuple(scene_names("analytic")) + ("clearance-pendulum",)
+
+
+@dataclass(frozen=True)
+class Cell:
+    """One run: status, message, the figures of each expectation, and stepping wall time."""
+
+    status: RunStatus
+    message: str
+    figures: dict
+    stepping_seconds: float
+    steps: int
+
+
+def run_cell(engine: Engine, scene: Scene, time_step: float,
+             horizon: float | None = None) -> Cell:
+    """Run ``scene`` at ``time_step`` and evaluate its expectations.
+
+    Samples are kept every ``scene.time_step`` (or every step when finer), so that the
+    evaluator costs the same at every time step.
+    """
+    record_every = max(1, round(scene.time_step / time_step))
+    trajectory = engine.run(scene, RunSettings(time_step=time_step, horizon=horizon,
+                                               record_every=record_every))
+    figures = {}
+    if len(trajectory.times) >= 2:
+        for result in evaluate(scene, trajectory):
+            figures[result.name] = (result.kind, dict(result.figures))
+    return Cell(trajectory.status, trajectory.message, figures, trajectory.stepping_seconds,
+                trajectory.steps)
+
+
+def table_rows(scene: Scene, cells: list[Cell]) -> list[tuple[str, list[str]]]:
+    """(label, one formatted value per cell) for every shown figure of ``scene``."""
+    rows = []
+    for expectation in scene.expectations:
+        for figure in TABLE_FIGURES.get(expectation.kind, ()):
+            if figure.key == "height_after_rest" and \
+                    expectation.parameters.get("restitution", 0.0) > 0:
+                continue
+            if figure.key.startswith("apex_") and \
+                    expectation.parameters.get("restitution", 1.0) == 0:
+                continue
+            values = []
+            for cell in cells:
+                kind_figures = cell.figures.get(expectation.name)
+                value = math.nan if kind_figures is None else \
+                    kind_figures[1].get(figure.key, math.nan)
+                values.append(format_value(value * figure.factor, cell))
+            unit = f" [{figure.unit}]" if figure.unit else ""
+            rows.append((f"{figure.label}{unit}", values))
+    return rows
+
+
+def format_value(value: float, cell: Cell) -> str:
+    """Three significant digits; the status when the run did not end OK."""
+    text = "n/a" if not math.isfinite(value) else f"{value + 0.0:.3g}"  # no "-0"
+    if cell.status is RunStatus.OK:
+        return text
+    return f"{text} ({cell.status.value})"
+
+
+def measure(engines: dict[str, Engine], time_steps: tuple[float, ...],
+            scenes: tuple[str, ...] = DEFAULT_SCENES, horizon: float | None = None,
+            progress=None) -> list[dict]:
+    """Run every (scene, engine, time step); per scene a dict with its name, column labels,
+    rows and the cells. ``progress(text)`` is called before each run."""
+    out = []
+    for name in scenes:
+        scene = get_scene(name)
+        labels, cells = [], []
+        for label, engine in engines.items():
+            for time_step in time_steps:
+                if progress:
+                    progress(f"{name} {label} dt={time_step:g}")
+                cells.append(run_cell(engine, scene, time_step, horizon))
+                labels.append(f"{label} dt={time_step:g}")
+        out.append({"scene": name, "labels": labels, "rows": table_rows(scene, cells),
+                    "cells": cells})
+    return out
+
+
+def markdown(measured: list[dict]) -> str:
+    """The measurements as Markdown tables, one per scene."""
+    lines = []
+    for block in measured:
+        lines.append(f"**{block['scene']}**")
+        lines.append("")
+        lines.append("| figure | " + " | ".join(block["labels"]) + " |")
+        lines.append("|---|" + "---:|" * len(block["labels"]))
+        for label, values in block["rows"]:
+            lines.append(f"| {label} | " + " | ".join(values) + " |")
+        seconds = [f"{c.stepping_seconds / max(c.steps, 1) * 1e6:.3g}" for c in block["cells"]]
+        lines.append("| stepping time per step [us] | " + " | ".join(seconds) + " |")
+        notes = [f"{label}: {cell.message}" for label, cell in zip(block["labels"],
+                                                                   block["cells"], strict=True)
+                 if cell.message]
+        lines.append("")
+        for note in notes:
+            lines.append(f"- {note}")
+        if notes:
+            lines.append("")
+    return "\n".join(lines)
+
+
+def markdown_compact(measured: list[dict]) -> str:
+    """The measurements as one Markdown table: a row per (scene, figure), a column per
+    (engine, time step); runs that did not end OK carry their status."""
+    if not measured:
+        return ""
+    labels = measured[0]["labels"]
+    lines = ["| scene | figure | " + " | ".join(labels) + " |",
+             "|---|---|" + "---:|" * len(labels)]
+    for block in measured:
+        for label, values in block["rows"]:
+            lines.append(f"| {block['scene']} | {label} | " + " | ".join(values) + " |")
+    return "\n".join(lines)

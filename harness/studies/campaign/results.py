@@ -1,0 +1,135 @@
+"""A campaign's results as a table: one row per sample, read from the results store.
+
+Outputs are computed from each recorded trajectory by the campaign's output definitions (the
+shared output code of :mod:`clearbench.harness.measure.series`), so changing how an output is
+collected needs no rerun. Computed values are cached beside the store
+(``campaigns/<name>.outputs.json``), keyed by run key and a digest of the output definitions.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from dataclasses import asdict
+
+import numpy as np
+
+from clearbench.harness.measure.series import output_values
+from clearbench.harness.run.store import ResultsStore
+from clearbench.harness.studies.campaign.definition import CampaignDefinition, OutputSpec
+from clearbench.harness.studies.campaign.execution import CampaignLog, plan_samples
+
+
+def collect(spec: OutputSpec, times: np.ndarray, values: np.ndarray) -> float:
+    """The value of one output over a run: ``spec.statistic`` over the last ``spec.window``
+    (scene time units) of the samples ``values`` (T,) at ``times`` (T,)."""
+    if len(times) == 0:
+        return math.nan
+    if spec.statistic == "final":
+        return float(values[-1])
+    inside = times >= times[-1] - spec.window - 1e-9 * max(abs(times[-1]), 1.0)
+    window = values[inside]
+    reduce = {"mean": np.mean, "min": np.min, "max": np.max}[spec.statistic]
+    return float(reduce(window))
+
+
+def outputs_digest(definition: CampaignDefinition) -> str:
+    """Digest of how the outputs are collected (names, sources, statistics, windows)."""
+    text = json.dumps([[o.name, o.output, o.statistic, o.window] for o in definition.outputs])
+    return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
+def _output_cache(store: ResultsStore, definition: CampaignDefinition):
+    path = store.directory / "campaigns" / f"{definition.name}.outputs.json"
+    digest = outputs_digest(definition)
+    cache = {}
+    if path.exists():
+        try:
+            cache = json.loads(path.read_text(encoding="utf-8"))
+        except json.JSONDecodeError:  # a cache torn by a kill: recompute
+            cache = {}
+    return path, digest, cache.get(digest, {}), cache
+
+
+def run_outputs(store: ResultsStore, definition: CampaignDefinition, key: str,
+                scene) -> dict[str, float]:
+    """Every campaign output of the recorded run ``key`` (NaN where it has no trajectory)."""
+    trajectory = store.load_trajectory(key)
+    if trajectory is None or len(trajectory.times) == 0:
+        return {o.name: math.nan for o in definition.outputs}
+    series = output_values(scene, trajectory)
+    return {o.name: collect(o, trajectory.times, series[o.output]) for o in definition.outputs}
+
+
+def campaign_table(definition: CampaignDefinition, store: ResultsStore):
+    """One row per planned sample: sample, key, status, message, worker_seconds,
+    stepping_seconds, the inputs and the outputs by name (a pandas DataFrame). Samples not
+    recorded yet have status "pending"; outputs of runs that did not end ok are kept as
+    computed (the statistics use the ok runs and count the others)."""
+    import pandas as pd  # lazily, as the results store does
+
+    samples = plan_samples(definition)
+    path, digest, cached, whole = _output_cache(store, definition)
+    rows = []
+    changed = False
+    for sample in samples:
+        key = sample.spec.key
+        record = store.get(key)
+        row = {"sample": sample.index, "key": key}
+        row.update({law.name: float(v) for law, v in zip(definition.inputs, sample.inputs,
+                                                         strict=True)})
+        if record is None:
+            row.update(status="pending", message="", worker_seconds=math.nan,
+                       stepping_seconds=math.nan)
+            row.update({o.name: math.nan for o in definition.outputs})
+        else:
+            row.update(status=record["status"], message=record["message"],
+                       worker_seconds=record["worker_seconds"],
+                       stepping_seconds=record["stepping_seconds"])
+            if key not in cached:
+                cached[key] = run_outputs(store, definition, key, sample.spec.scene)
+                changed = True
+            row.update(cached[key])
+        rows.append(row)
+    if changed:
+        whole[digest] = cached
+        temporary = path.with_suffix(".tmp")
+        temporary.write_text(json.dumps(whole), encoding="utf-8")
+        temporary.replace(path)
+    return pd.DataFrame(rows)
+
+
+def throughput(store: ResultsStore, definition: CampaignDefinition) -> dict:
+    """Samples per hour and wall seconds per sample, from the campaign's own log: per session,
+    the samples it recorded over the time from its start to its last record."""
+    entries = CampaignLog(store, definition.name).entries()
+    sessions: dict[str, dict] = {}
+    for entry in entries:
+        session = sessions.setdefault(entry["session"], {"samples": 0, "elapsed": 0.0,
+                                                         "workers": None, "worker_seconds": []})
+        if entry.get("event") == "start":
+            session["workers"] = entry.get("workers")
+        elif entry.get("event") == "sample":
+            session["samples"] += 1
+            session["elapsed"] = max(session["elapsed"], entry["elapsed_s"])
+            session["worker_seconds"].append(entry.get("worker_seconds", math.nan))
+    samples = sum(s["samples"] for s in sessions.values())
+    elapsed = sum(s["elapsed"] for s in sessions.values())
+    seconds = [x for s in sessions.values() for x in s["worker_seconds"] if x == x]
+    workers = sorted({s["workers"] for s in sessions.values() if s["workers"]})
+    return {
+        "sessions": len(sessions), "samples": samples, "wall_seconds": elapsed,
+        "samples_per_hour": 3600.0 * samples / elapsed if elapsed > 0 else math.nan,
+        "worker_seconds_per_sample": float(np.median(seconds)) if seconds else math.nan,
+        "workers": workers,
+    }
+
+
+def definition_summary(definition: CampaignDefinition) -> dict:
+    """The definition as plain data (for the report's JSON)."""
+    return {"name": definition.name, "scene": definition.scene, "engine": definition.engine,
+            "design": definition.design, "samples": definition.samples,
+            "seed": definition.seed, "scene_parameters": dict(definition.scene_parameters),
+            "inputs": [asdict(law) for law in definition.inputs],
+            "outputs": [asdict(o) for o in definition.outputs]}
