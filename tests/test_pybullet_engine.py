@@ -13,7 +13,6 @@ import dataclasses
 import math
 
 import numpy as np
-import pybullet as pb
 import pytest
 
 from clearbench.adapters.base import RunSettings, Support
@@ -21,6 +20,7 @@ from clearbench.adapters.pybullet import create
 from clearbench.adapters.pybullet.build import build_world, disconnect
 from clearbench.adapters.pybullet.frames import from_pb
 from clearbench.adapters.pybullet.gaps import pair_distances
+from clearbench.adapters.pybullet.library import pb
 from clearbench.adapters.pybullet.run import Runner
 from clearbench.adapters.pybullet.settings import resolve_settings
 from clearbench.adapters.trajectory import RunStatus

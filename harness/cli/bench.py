@@ -8,14 +8,15 @@ and a function that measures (with :mod:`clearbench.harness.studies.benchmarks`)
 from __future__ import annotations
 
 import argparse
+import importlib
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from clearbench.adapters import engine_availability, mujoco, siconos
-from clearbench.adapters import reference as reference_engine
+from clearbench.adapters import siconos
 from clearbench.harness.cli.common import UserError
+from clearbench.harness.run.engine_choice import RunInputError, resolve_engine
 from clearbench.harness.studies.benchmarks import (
     clearance_ladder,
     kernel_speed,
@@ -183,9 +184,8 @@ def bench_clearance_ladder(args: argparse.Namespace) -> int:
 
 
 # ---------------------------------------------------------------------------- other engines
-def _mujoco_table_options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--preset", action="append", dest="presets",
-                        help="MuJoCo preset (repeatable; default: default and tuned)")
+def _table_options(parser: argparse.ArgumentParser) -> None:
+    """Options shared by ``physics-table`` and ``mujoco-table``."""
     parser.add_argument("--dt", action="append", type=float, dest="time_steps",
                         help="time step [s] (repeatable; default: 1e-3 and 1e-4)")
     parser.add_argument("--scene", action="append", dest="scenes",
@@ -197,20 +197,37 @@ def _mujoco_table_options(parser: argparse.ArgumentParser) -> None:
                         help="add the reference solver (default preset) as a column")
     parser.add_argument("--compact", action="store_true",
                         help="one table for all scenes (a row per scene and figure)")
+
+
+def _physics_table_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--engine", "-e", action="append", dest="engines",
+                        metavar="ENGINE[PRESET]",
+                        help="engine and preset, e.g. 'pybullet[tuned]' (repeatable; a column "
+                        "per engine and time step)")
+    _table_options(parser)
+
+
+def _mujoco_table_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--preset", action="append", dest="presets",
+                        help="MuJoCo preset (repeatable; default: default and tuned)")
+    _table_options(parser)
     parser.add_argument("--no-mujoco", action="store_true",
                         help="leave out the MuJoCo columns (with --reference: the reference "
                         "column alone)")
 
 
-def bench_mujoco_table(args: argparse.Namespace) -> int:
-    available = engine_availability("mujoco")
-    if not available.available:
-        raise UserError(f"mujoco is not available: {available.detail}")
-    presets = args.presets or ["default", "tuned"]
-    for preset in presets:   # the engine's own preset check, before any run
+def _print_physics_table(labels: list[str], args: argparse.Namespace) -> int:
+    """Check the engine labels, scenes and steps of a table (exit 2 naming the bad value, before
+    any run), run every cell and print the Markdown."""
+    if args.reference:
+        labels = [*labels, "reference"]
+    if not labels:
+        raise UserError("nothing to run: give --engine ENGINE[PRESET] (or --reference)")
+    choices = []
+    for label in labels:
         try:
-            mujoco.MujocoEngine(preset)
-        except ValueError as error:
+            choices.append(resolve_engine(label, field="--engine"))
+        except RunInputError as error:
             raise UserError(str(error)) from None
     scenes = tuple(args.scenes or physics_table.DEFAULT_SCENES)
     missing = sorted(set(scenes) - set(scene_names()))
@@ -219,17 +236,28 @@ def bench_mujoco_table(args: argparse.Namespace) -> int:
     time_steps = tuple(args.time_steps or (1e-3, 1e-4))
     if any(not dt > 0 for dt in time_steps):
         raise UserError(f"--dt must be > 0, got {time_steps}")
-    engines = {} if args.no_mujoco else {f"mujoco[{p}]": mujoco.create(p) for p in presets}
-    if not engines and not args.reference:
-        raise UserError("nothing to run: --no-mujoco without --reference")
-    if args.reference:
-        engines["reference"] = reference_engine.create()
+    if args.horizon is not None and not args.horizon > 0:
+        raise UserError(f"--horizon must be > 0, got {args.horizon}")
+    engines = {(label if label == "reference" else choice.label):
+               importlib.import_module(choice.module).create(choice.preset)
+               for label, choice in zip(labels, choices, strict=True)}
     measured = physics_table.measure(
         engines, time_steps, scenes, args.horizon,
-        progress=lambda text: print(f"running {text}", file=sys.stderr))
+        progress=lambda text: print(f"running {text}", file=sys.stderr, flush=True))
     print(physics_table.markdown_compact(measured) if args.compact
           else physics_table.markdown(measured))
     return 0
+
+
+def bench_physics_table(args: argparse.Namespace) -> int:
+    return _print_physics_table(list(args.engines or []), args)
+
+
+def bench_mujoco_table(args: argparse.Namespace) -> int:
+    presets = [] if args.no_mujoco else (args.presets or ["default", "tuned"])
+    if args.no_mujoco and not args.reference:
+        raise UserError("nothing to run: --no-mujoco without --reference")
+    return _print_physics_table([f"mujoco[{preset}]" for preset in presets], args)
 
 
 def bench_siconos_crosscheck(args: argparse.Namespace) -> int:
@@ -269,10 +297,19 @@ BENCHMARKS: dict[str, Benchmark] = {
     "fc3d-sweep": Benchmark("us per contact per NSGS sweep on the shipped FCLIB problems",
                             bench_fc3d_sweep, _fc3d_sweep_options),
     "geometry": Benchmark("ns per pair_contacts call, from inside a numba loop", bench_geometry),
+    "physics-table": Benchmark(
+        "an engine's error against physics on the analytic scenes (per engine[preset] and dt)",
+        bench_physics_table, _physics_table_options,
+        "Run every analytic scene (and the clearance pendulum) in each --engine ENGINE[PRESET] "
+        "at each time step, and print, per scene, the figures of the shared expectation "
+        "evaluator (apex errors, creep, energy drift, clearance excess, ...) and the stepping "
+        "time per step as Markdown tables; engine, preset, scene and step are checked before "
+        "any run. With --reference, the reference solver runs the same cells."),
     "mujoco-table": Benchmark(
-        "MuJoCo's error against physics on the analytic scenes (per preset and dt)",
+        "physics-table for MuJoCo's presets (default and tuned unless --preset)",
         bench_mujoco_table, _mujoco_table_options,
-        "Run every analytic scene (and the clearance pendulum) in MuJoCo with each preset at "
+        "physics-table with --engine mujoco[PRESET] for each --preset: run every analytic "
+        "scene (and the clearance pendulum) in MuJoCo with each preset at "
         "each time step, and print, per scene, the figures of the shared expectation evaluator "
         "(apex ratios, creep, energy drift, clearance excess, ...) as Markdown tables. With "
         "--reference, the reference solver runs the same cells."),
