@@ -70,3 +70,18 @@ def test_physics_table_rejects_bad_engines_before_running(capsys):
     assert main(["bench", "physics-table", "-e", "pybullet[fast]"]) == 2
     assert "'fast'" in capsys.readouterr().err
     assert main(["bench", "physics-table", "-e", "mujoco", "--horizon", "0"]) == 2
+
+
+def test_table_options_are_checked_before_any_run(capsys):
+    assert main(["bench", "physics-table", "-e", "pybullet[tuned]", "--option", "nope=1"]) == 2
+    assert "unknown pybullet options ['nope']" in capsys.readouterr().err
+    assert main(["bench", "contact-cost", "-e", "pybullet[tuned]", "--option",
+                 "num_solver_iterations=0"]) == 2
+    assert "num_solver_iterations=0" in capsys.readouterr().err
+
+
+def test_contact_cost_prints_a_row_per_box_count(capsys):
+    assert main(["bench", "contact-cost", "-e", "pybullet[tuned]", "--boxes", "1",
+                 "--boxes", "4", "--dt", "1e-3", "--horizon", "0.005"]) == 0
+    out = capsys.readouterr().out
+    assert "| pybullet[tuned] | 1 (4) |" in out and "| pybullet[tuned] | 4 (16) |" in out

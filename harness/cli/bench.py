@@ -15,10 +15,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from clearbench.adapters import siconos
-from clearbench.harness.cli.common import UserError
+from clearbench.harness.cli.common import UserError, assignments
 from clearbench.harness.run.engine_choice import RunInputError, resolve_engine
 from clearbench.harness.studies.benchmarks import (
     clearance_ladder,
+    contact_cost,
     kernel_speed,
     physics,
     physics_table,
@@ -197,6 +198,13 @@ def _table_options(parser: argparse.ArgumentParser) -> None:
                         help="add the reference solver (default preset) as a column")
     parser.add_argument("--compact", action="store_true",
                         help="one table for all scenes (a row per scene and figure)")
+    _engine_option(parser)
+
+
+def _engine_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--option", action="append", default=[], metavar="KEY=VALUE",
+                        help="engine option over every preset of the table (repeatable; "
+                        "checked by each engine before any run)")
 
 
 def _physics_table_options(parser: argparse.ArgumentParser) -> None:
@@ -216,19 +224,35 @@ def _mujoco_table_options(parser: argparse.ArgumentParser) -> None:
                         "column alone)")
 
 
+def _engines(labels: list[str], options: dict) -> dict:
+    """``ENGINE[PRESET]`` labels -> created engines, each checked (known, available, preset,
+    the names of ``options``) before any run; UserError (exit 2) naming the bad value."""
+    if not labels:
+        raise UserError("nothing to run: give --engine ENGINE[PRESET] (or --reference)")
+    engines = {}
+    for label in labels:
+        try:
+            choice = resolve_engine(label, options=options, field="--engine")
+        except RunInputError as error:
+            raise UserError(str(error)) from None
+        engine = importlib.import_module(choice.module).create(choice.preset)
+        resolve_settings = getattr(engine, "settings", None)  # engines with a settings object
+        if options and callable(resolve_settings):
+            try:
+                resolve_settings(options)  # the option values, checked by the engine
+            except ValueError as error:
+                raise UserError(f"--option: {error}") from None
+        engines[label if label == "reference" else choice.label] = engine
+    return engines
+
+
 def _print_physics_table(labels: list[str], args: argparse.Namespace) -> int:
     """Check the engine labels, scenes and steps of a table (exit 2 naming the bad value, before
     any run), run every cell and print the Markdown."""
     if args.reference:
         labels = [*labels, "reference"]
-    if not labels:
-        raise UserError("nothing to run: give --engine ENGINE[PRESET] (or --reference)")
-    choices = []
-    for label in labels:
-        try:
-            choices.append(resolve_engine(label, field="--engine"))
-        except RunInputError as error:
-            raise UserError(str(error)) from None
+    options = assignments(args.option, "--option")
+    engines = _engines(labels, options)
     scenes = tuple(args.scenes or physics_table.DEFAULT_SCENES)
     missing = sorted(set(scenes) - set(scene_names()))
     if missing:
@@ -238,12 +262,10 @@ def _print_physics_table(labels: list[str], args: argparse.Namespace) -> int:
         raise UserError(f"--dt must be > 0, got {time_steps}")
     if args.horizon is not None and not args.horizon > 0:
         raise UserError(f"--horizon must be > 0, got {args.horizon}")
-    engines = {(label if label == "reference" else choice.label):
-               importlib.import_module(choice.module).create(choice.preset)
-               for label, choice in zip(labels, choices, strict=True)}
     measured = physics_table.measure(
         engines, time_steps, scenes, args.horizon,
-        progress=lambda text: print(f"running {text}", file=sys.stderr, flush=True))
+        progress=lambda text: print(f"running {text}", file=sys.stderr, flush=True),
+        options=options)
     print(physics_table.markdown_compact(measured) if args.compact
           else physics_table.markdown(measured))
     return 0
@@ -258,6 +280,37 @@ def bench_mujoco_table(args: argparse.Namespace) -> int:
     if args.no_mujoco and not args.reference:
         raise UserError("nothing to run: --no-mujoco without --reference")
     return _print_physics_table([f"mujoco[{preset}]" for preset in presets], args)
+
+
+def _contact_cost_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--engine", "-e", action="append", dest="engines",
+                        metavar="ENGINE[PRESET]", help="engine and preset (repeatable)")
+    parser.add_argument("--boxes", action="append", type=int,
+                        help="box count (repeatable; default: 1 4 9 16 26)")
+    parser.add_argument("--dt", action="append", type=float, dest="time_steps",
+                        help="time step [s] (repeatable; default: 1e-3 and 1e-4)")
+    parser.add_argument("--horizon", type=float, default=contact_cost.DEFAULT_HORIZON,
+                        help="simulated duration [s] (default 0.05: the 1 mm drop and settling)")
+    _engine_option(parser)
+
+
+def bench_contact_cost(args: argparse.Namespace) -> int:
+    boxes = tuple(args.boxes or contact_cost.DEFAULT_BOXES)
+    if any(count < 1 for count in boxes):
+        raise UserError(f"--boxes must be >= 1, got {boxes}")
+    time_steps = tuple(args.time_steps or (1e-3, 1e-4))
+    if any(not dt > 0 for dt in time_steps) or not args.horizon > 0:
+        raise UserError(f"--dt and --horizon must be > 0, got {time_steps}, {args.horizon}")
+    options = assignments(args.option, "--option")
+    engines = _engines(list(args.engines or []), options)
+    rows = contact_cost.contact_costs(
+        engines, boxes, time_steps, args.horizon,
+        progress=lambda text: print(f"running {text}", file=sys.stderr, flush=True),
+        options=options)
+    print(f"box_grid(count) for {args.horizon:g} s: wall time and solver iterations per "
+          "nominal step (and the engine's own steps where it reports them)")
+    print(contact_cost.markdown(rows))
+    return 0
 
 
 def bench_siconos_crosscheck(args: argparse.Namespace) -> int:
@@ -305,6 +358,9 @@ BENCHMARKS: dict[str, Benchmark] = {
         "evaluator (apex errors, creep, energy drift, clearance excess, ...) and the stepping "
         "time per step as Markdown tables; engine, preset, scene and step are checked before "
         "any run. With --reference, the reference solver runs the same cells."),
+    "contact-cost": Benchmark(
+        "cost per step as contacts grow (box_grid, per engine[preset] and dt)",
+        bench_contact_cost, _contact_cost_options),
     "mujoco-table": Benchmark(
         "physics-table for MuJoCo's presets (default and tuned unless --preset)",
         bench_mujoco_table, _mujoco_table_options,
