@@ -27,6 +27,7 @@ an UNSUPPORTED trajectory and their reasons, then ``_run``. Failures of a run ar
 from __future__ import annotations
 
 import enum
+import math
 from abc import ABC, abstractmethod
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -35,6 +36,50 @@ from typing import Any, ClassVar
 from clearbench.adapters.trajectory import RunStatus, Trajectory
 from clearbench.scenarios.features import FeatureKind, parse_feature
 from clearbench.scenarios.scene import Scene
+
+
+def option_error(engine: str, name: str, value, reason: str) -> ValueError:
+    """The error every engine raises for a bad option value: ``<engine> option NAME=VALUE:
+    reason``."""
+    return ValueError(f"{engine} option {name}={value!r}: {reason}")
+
+
+def check_option_number(engine: str, name: str, value, lower: float | None = None,
+                        upper: float | None = None, strict: bool = False) -> None:
+    """A finite real number (not a bool) within the bounds (``strict``: lower excluded);
+    :func:`option_error` otherwise."""
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise option_error(engine, name, value, "must be a finite number")
+    if lower is not None and (value <= lower if strict else value < lower):
+        raise option_error(engine, name, value,
+                           f"must be a finite number {'>' if strict else '>='} {lower:g}")
+    if upper is not None and value > upper:
+        raise option_error(engine, name, value, f"must be <= {upper:g}")
+
+
+def check_option_values(engine: str, settings, *, choices: Mapping[str, tuple] | None = None,
+                        booleans: Sequence[str] = (), integers: Mapping[str, int] | None = None,
+                        positive: Sequence[str] = (), non_negative: Sequence[str] = ()) -> None:
+    """The value checks every engine's settings dataclass runs in ``__post_init__``.
+
+    ``choices``: field -> allowed values; ``booleans``: fields that must be bool; ``integers``:
+    field -> least value (bools refused); ``positive`` / ``non_negative``: finite numbers > 0
+    / >= 0. Raises :func:`option_error` for the first field that fails, before any run.
+    """
+    for name, allowed in (choices or {}).items():
+        if getattr(settings, name) not in allowed:
+            raise option_error(engine, name, getattr(settings, name), f"must be one of {allowed}")
+    for name in booleans:
+        if not isinstance(getattr(settings, name), bool):
+            raise option_error(engine, name, getattr(settings, name), "must be true or false")
+    for name, least in (integers or {}).items():
+        value = getattr(settings, name)
+        if isinstance(value, bool) or not isinstance(value, int) or value < least:
+            raise option_error(engine, name, value, f"must be an integer >= {least}")
+    for name in positive:
+        check_option_number(engine, name, getattr(settings, name), lower=0.0, strict=True)
+    for name in non_negative:
+        check_option_number(engine, name, getattr(settings, name), lower=0.0)
 
 
 class Support(enum.Enum):

@@ -14,12 +14,14 @@ from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.scales import largest_shape_dimension
 from clearbench.scenarios.scene import Scene
 
-__all__ = ["ENERGY_EXPECTATIONS", "WORK_FEATURES", "EnergyGuard"]
+__all__ = ["ENERGY_EXPECTATIONS", "SPRING_WORK_FEATURES", "WORK_FEATURES", "EnergyGuard"]
 
 #: Expectation kinds under which the energy of the scene may not grow.
 ENERGY_EXPECTATIONS = ("energy_non_increasing", "energy_conserved")
 #: Features that do work an engine's energy bookkeeping does not count (the guard stays off).
 WORK_FEATURES = ("drivers", "point_forces", "moments", "angle_law_loads", "distance_law_loads")
+#: The same plus torsional springs, for engines whose energy counts linear springs only.
+SPRING_WORK_FEATURES = (*WORK_FEATURES, "torsional_springs")
 
 
 class EnergyGuard:

@@ -16,9 +16,13 @@ import numpy as np
 
 from clearbench.ref_solver.forces import element_forces, no_angle_memory, remember_angles
 from clearbench.ref_solver.scene_system import build_system, law_load_problems
+from clearbench.ref_solver.system import FORCE_ANGLE_LAW, FORCE_DISTANCE_LAW
 from clearbench.scenarios.scene import Scene
 
-__all__ = ["ForceElements", "law_load_problems", "scene_force_elements"]
+__all__ = ["LAW_KINDS", "ForceElements", "law_load_problems", "scene_force_elements"]
+
+#: Element kinds of the C-60's law loads (angle and distance laws).
+LAW_KINDS = (FORCE_ANGLE_LAW, FORCE_DISTANCE_LAW)
 
 
 @dataclass

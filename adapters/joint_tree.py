@@ -12,6 +12,7 @@ tree joint's coordinate only when the joint axis is the world axis of the driven
 
 from __future__ import annotations
 
+from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,7 +23,7 @@ from clearbench.scenarios.joints import Joint
 from clearbench.scenarios.scene import Scene
 
 __all__ = ["AXIS_TOLERANCE", "TREE_PRIORITY", "DrivenDof", "JointGraph", "axis_sign",
-           "rotations_held", "split_joint_graph"]
+           "breadth_first_edges", "plan_drivers", "rotations_held", "split_joint_graph"]
 
 #: Preference of a joint kind as a tree edge (lower first).
 TREE_PRIORITY = {"prismatic": 0, "revolute": 1, "spherical": 2, "fixed": 3}
@@ -126,3 +127,70 @@ def axis_sign(joint: Joint, driver: Driver) -> float | None:
     if abs(abs(alignment) - 1.0) >= AXIS_TOLERANCE:
         return None
     return float(np.sign(alignment))
+
+
+def breadth_first_edges(adjacency: dict, starts, visited: set) -> list[tuple[str, Joint, str]]:
+    """(parent, joint, child) of every body reached breadth-first from the bodies ``starts``
+    through tree joints (``JointGraph.adjacency``), skipping bodies in ``visited``; the bodies
+    reached are added to ``visited``. Parents come before their children."""
+    edges = []
+    queue = deque(starts)
+    while queue:
+        current = queue.popleft()
+        for joint, other in adjacency[current]:
+            if other in visited:
+                continue
+            visited.add(other)
+            edges.append((current, joint, other))
+            queue.append(other)
+    return edges
+
+
+def plan_drivers(scene: Scene, drivers_of: dict, translation_driven: set,
+                 grounded_joint: dict, engine: str) -> tuple[dict, list]:
+    """Which joint coordinate each driver prescribes, the same rule for every tree engine.
+
+    Parameters
+    ----------
+    scene : Scene
+    drivers_of : dict
+        Body name -> its drivers (``JointGraph.drivers_of``).
+    translation_driven : set of str
+        Bodies without ideal joints given slides x, y, z of their own (and a ball joint unless
+        their rotations are held): their translation drivers drive those slides.
+    grounded_joint : dict
+        Body name -> name of its revolute or prismatic tree joint to a fixed body.
+    engine : str
+        Engine name for the problem text.
+
+    Returns
+    -------
+    driven : dict
+        Body name -> tuple of :class:`DrivenDof`.
+    problems : list of (feature, reason)
+        Drivers the engine cannot prescribe.
+    """
+    joints = {j.name: j for j in scene.joints}
+    driven: dict[str, tuple] = {}
+    problems = []
+    for body, drivers in drivers_of.items():
+        if body in translation_driven:
+            # Held rotations have no joint: the orientation cannot change (exact).
+            driven[body] = tuple(DrivenDof(d, f"slide_{d.component}") for d in drivers
+                                 if not d.is_rotation)
+            continue
+        if body in grounded_joint and len(drivers) == 1:
+            # The joint axis is the scene joint's (world, initial pose): the coordinate is the
+            # body's rotation (translation) about (along) it.
+            sign = axis_sign(joints[grounded_joint[body]], drivers[0])
+            if sign is not None:
+                driven[body] = (DrivenDof(drivers[0], "tree", sign),)
+                continue
+        components = ", ".join(d.component for d in drivers)
+        problems.append((
+            "drivers",
+            f"body {body!r} (drivers on {components}): {engine} can prescribe a component only "
+            "as a joint coordinate of its own: one rotation (translation) by a revolute "
+            "(prismatic) joint to a fixed body about (along) that world axis, or translations "
+            "of a body with no ideal joint (its rotations undriven, or all three held at zero)"))
+    return driven, problems

@@ -108,6 +108,18 @@ def test_stability_runs_every_stiff_case(tmp_path, capsys):
     assert "unsupported" in text  # the fake engine has no clearance joints
 
 
+def test_stability_includes_pybullet_and_exudyn_by_default():
+    """Issues 14 and 15: without -e, the stiff suite runs every available engine, the two
+    compliant engines of the dependencies included (both are installed here)."""
+    from clearbench.harness.studies.stability import available_engines, plan_stability
+
+    labels = {choice.label for choice in available_engines()}
+    assert {"pybullet[default]", "exudyn[default]"} <= labels
+    planned = {spec.engine.label
+               for spec in plan_stability(available_engines(), ["stiff-spring"])}
+    assert {"pybullet[default]", "exudyn[default]"} <= planned
+
+
 @pytest.mark.slow
 def test_demo_is_the_default_comparison(tmp_path, capsys):
     """The README's main job end to end on the engines available here (minutes)."""

@@ -13,7 +13,6 @@ import dataclasses
 import math
 
 import numpy as np
-import pybullet as pb
 import pytest
 
 from clearbench.adapters.base import RunSettings, Support
@@ -21,9 +20,11 @@ from clearbench.adapters.pybullet import create
 from clearbench.adapters.pybullet.build import build_world, disconnect
 from clearbench.adapters.pybullet.frames import from_pb
 from clearbench.adapters.pybullet.gaps import pair_distances
+from clearbench.adapters.pybullet.library import pb
 from clearbench.adapters.pybullet.run import Runner
 from clearbench.adapters.pybullet.settings import resolve_settings
 from clearbench.adapters.trajectory import RunStatus
+from clearbench.harness.studies.benchmarks.physics_table import run_cell
 from clearbench.kernels.quaternion import quat_to_matrix
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.library import get_scene, scene_names
@@ -203,3 +204,35 @@ def test_internal_units_are_recorded():
     settings = RunSettings(horizon=2 * scene.time_step)
     assert create("tuned").run(scene, settings).metadata["internal_units"].startswith("mm")
     assert create("default").run(scene, settings).metadata["internal_units"].startswith("m")
+
+
+# ---------------------------------------------------------------------------- traps (ENGINES.md)
+def test_defaults_swallow_the_bounce_and_tuned_restores_it():
+    """Restitution trap: with PyBullet's defaults (restitution velocity threshold 0.2 m/s,
+    penetration recovery by contactERP, body damping) bouncing-ball-e0.5 keeps almost no
+    bounce (first apex measured -95 % at dt 1e-3); tuned measured -0.88 %. Bounds: the default
+    loses more than half the apex height, tuned stays within 2 % of it."""
+    scene = get_scene("bouncing-ball-e0.5")
+    errors = {}
+    for preset in PRESETS:
+        cell = run_cell(create(preset), scene, 1e-3)
+        assert cell.status is RunStatus.OK, cell.message
+        errors[preset] = cell.figures["apex_heights"][1]["apex_1_relative_error"]
+    assert errors["default"] < -0.5
+    assert abs(errors["tuned"]) < 0.02
+
+
+def test_body_damping_slows_free_fall_unless_switched_off():
+    """PyBullet damps bodies by default (0.04, multibodies): the ball of bouncing-ball-e0.5
+    falls 0.4 s (before touching at 0.45 s) more slowly than g t. Tuned sets damping 0: its
+    speed is g t to 1e-6 relative (step integration of a constant force is exact up to
+    round-off); the default's is more than 1 % short (measured 8.55 instead of 9.81 m/s
+    after 1 s, i.e. about 5 % at 0.4 s)."""
+    scene = get_scene("bouncing-ball-e0.5")
+    speeds = {}
+    for preset in PRESETS:
+        trajectory = create(preset).run(scene, RunSettings(time_step=1e-3, horizon=0.4))
+        speeds[preset] = -trajectory.velocities[-1, 1, 2]
+    free_fall = 9.81 * 0.4  # scene gravity 9.81 m/s^2
+    assert speeds["tuned"] == pytest.approx(free_fall, rel=1e-6)
+    assert speeds["default"] < 0.99 * free_fall

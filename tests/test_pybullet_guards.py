@@ -4,9 +4,10 @@ the raw engine (docs/engines/pybullet.md, "Traps guarded against"). About 20 s."
 from __future__ import annotations
 
 import dataclasses
+import subprocess
+import sys
 
 import numpy as np
-import pybullet as pb
 import pytest
 
 from clearbench.adapters.base import RunSettings
@@ -19,6 +20,7 @@ from clearbench.adapters.pybullet.geometry import (
     collision_groups,
     side_geometry,
 )
+from clearbench.adapters.pybullet.library import pb
 from clearbench.adapters.pybullet.settings import resolve_settings
 from clearbench.adapters.pybullet.shapes import create_shape
 from clearbench.adapters.trajectory import RunStatus
@@ -206,3 +208,15 @@ def test_fixed_bodies_are_not_moved_by_the_guards():
         check_mass_properties(built)
     finally:
         disconnect(built)
+
+
+def test_importing_the_adapter_prints_nothing():
+    """PyBullet prints its build time when first imported; the adapter's import drops it (a
+    fresh interpreter, since this one has imported pybullet already)."""
+    code = ("from clearbench.adapters.pybullet import availability, create; "
+            "assert availability()[0]; create('tuned')")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=120, check=False)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout == ""
+    assert "build time" not in done.stderr

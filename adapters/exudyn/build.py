@@ -26,13 +26,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from clearbench.adapters.exudyn.geometry import PairPlan, plan_contacts, reduced_mass
-from clearbench.adapters.exudyn.laws import LawForces, law_forces
+from clearbench.adapters.exudyn.laws import law_forces
 from clearbench.adapters.exudyn.settings import (
     ExudynSettings,
     contact_damping,
     contact_stiffness,
     exudyn_restitution,
 )
+from clearbench.adapters.force_elements import ForceElements
 from clearbench.kernels.quaternion import quat_to_matrix
 from clearbench.kernels.time_profiles import profile_integral, profile_value
 from clearbench.scenarios.bodies import Motion
@@ -152,7 +153,7 @@ class BuiltSystem:
     connectors: list[ConnectorRef]
     pair_plans: list[PairPlan]
     time_step: float
-    law_forces: LawForces | None = None
+    law_forces: ForceElements | None = None  # the C-60 law loads (angle, distance laws)
     law_loads: list = field(default_factory=list)   # (body index, force load, torque load)
     keep_alive: list = field(default_factory=list)  # user functions Exudyn must not lose
     warnings: list[str] = field(default_factory=list)
@@ -368,11 +369,12 @@ def _add_loads(built: BuiltSystem, scene: Scene, settings: ExudynSettings) -> No
             continue  # all law loads together below
         else:  # pragma: no cover
             raise TypeError(f"unhandled load kind {load.kind!r}")
-    laws = law_forces(scene)
-    if laws is None:
+    found = law_forces(scene)
+    if found is None:
         return
+    laws, acted = found
     built.law_forces = laws
-    for b in laws.acted:
+    for b in acted:
         item = items[laws.body_names[b]]
         com = list(scene.body(laws.body_names[b]).center_of_mass)
         force = mbs.CreateForce(itemNumber=item, loadVector=[0.0, 0.0, 0.0], localPosition=com,

@@ -143,8 +143,8 @@ def _metadata(scene: Scene, internal: Scene, config: ExudynSettings, built, runn
         "discontinuous_iteration_failures": runner.discontinuous_failures_total,
         "solver_error": runner.error_string,
         "captured_stdout": runner.captured_stdout[-2000:],
-        "energy_initial": runner.energy_initial,
-        "energy_max_gain": runner.energy_max_gain,
+        "energy_initial": runner.guard.energy_initial,
+        "energy_max_gain": runner.guard.max_gain,
         # Exudyn does not clip the normal force at zero: the most negative recorded sum of a
         # pair (model units; 0 when none pulled).
         "min_normal_force": runner.min_normal_force,

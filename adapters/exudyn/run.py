@@ -1,13 +1,17 @@
 """The step loop of an Exudyn run: solver settings, recording, guards, read-out.
 
 Exudyn is stepped by its own ``MainSolverImplicitSecondOrder`` (``InitializeSolver``,
-``SolveSteps``, ``FinalizeSolver``), one ``SolveSteps`` call per nominal step with the
-solver's end time at that step's end: a step Exudyn reduces (Newton failure, contact instant)
-is followed by smaller steps up to the grid time, so that every sample is at a multiple of
-the step (one call over the whole horizon leaves the grid after the first reduction). A
-PostStep user function (called after every accepted step, after the discontinuous iterations,
-and once more at the start of each call: skipped) records samples and runs the guards, and
-stops the solver by returning False. A PreStep function applies explicit law loads.
+``SolveSteps``, ``FinalizeSolver``). Option ``step_loop``: 'horizon' (the presets) makes one
+``SolveSteps`` call over the whole run, as ``exu.SolveDynamic`` does, and leaves Exudyn's step
+control alone: after a step reduced to a contact instant it keeps the short steps through the
+impact and grows them back after ``adaptiveStepRecoverySteps`` good steps; a sample is the
+first step end at or after its time, so sample times can leave the grid by less than a step.
+'grid' makes one call per nominal step ending on the grid; each call restarts at the nominal
+step (``SolveSteps`` resets ``currentStepSize``), so impacts are integrated with full steps
+(measured in docs/engines/exudyn.md). A PostStep user function (called after every accepted
+step, after the discontinuous iterations, and once more at the start of each call: skipped)
+records samples and runs the guards, and stops the solver by returning False. A PreStep
+function applies explicit law loads.
 
 Guards:
 - files: ``solution.file.write``, ``solution.sensors.active``, restart files, verbose files
@@ -18,7 +22,8 @@ Guards:
 - solver failure: ``SolveSteps`` returning False or raising ``SolverError`` /
   ``ExudynError`` (Newton failure after the step reductions, singular Jacobian) stops the run
   as DIVERGED with Exudyn's error string (CRASHED for other exceptions);
-- non-finite state, and energy gain on scenes whose energy may not grow: DIVERGED.
+- non-finite state, and energy gain on scenes whose energy may not grow
+  (:class:`~clearbench.adapters.energy_guard.EnergyGuard`, shared): DIVERGED.
 """
 
 from __future__ import annotations
@@ -26,11 +31,11 @@ from __future__ import annotations
 import contextlib
 import io
 import logging
-import math
 import time
 
 import numpy as np
 
+from clearbench.adapters.energy_guard import SPRING_WORK_FEATURES, EnergyGuard
 from clearbench.adapters.exudyn.build import BuiltSystem, load_exudyn
 from clearbench.adapters.exudyn.settings import ExudynSettings
 from clearbench.adapters.recording import SampleRecorder
@@ -38,16 +43,9 @@ from clearbench.adapters.trajectory import RunStatus
 from clearbench.kernels.quaternion import quat_to_matrix_batch
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.loads import LinearSpringDamper
-from clearbench.scenarios.scales import largest_shape_dimension
 from clearbench.scenarios.scene import Scene
 
 logger = logging.getLogger(__name__)
-
-#: Expectation kinds under which the energy of the scene may not grow.
-ENERGY_EXPECTATIONS = ("energy_non_increasing", "energy_conserved")
-#: Features that do work the energy bookkeeping does not count (the guard stays off).
-WORK_FEATURES = ("drivers", "point_forces", "moments", "angle_law_loads", "distance_law_loads",
-                 "torsional_springs")
 
 
 def simulation_settings(settings: ExudynSettings, time_step: float, steps: int,
@@ -108,7 +106,6 @@ class Runner:
         self.stepping_seconds = 0.0
         self.record_seconds = 0.0
         self.problem: str | None = None
-        self.guard_notes: list[str] = []
         self.captured_stdout = ""
         self.error_string = ""
         self.mass = np.array([b.mass for b in scene.bodies])
@@ -117,40 +114,16 @@ class Runner:
         self.gravity = np.asarray(scene.gravity, dtype=float)
         self._springs = [(load, scene.body_index(load.body_a), scene.body_index(load.body_b))
                          for load in scene.loads if isinstance(load, LinearSpringDamper)]
-        self._energy_guard = self._energy_guard_applies()
-        self._size_energy = self._size_energy_scale()
-        self.energy_initial = math.nan
-        self.energy_max_gain = 0.0
-        self._kinetic_max = 0.0
+        self.guard = EnergyGuard(scene, config.energy_gain_tolerance, config.guard_interval,
+                                 SPRING_WORK_FEATURES)
+        self.guard_notes = self.guard.notes
         self._newton_count = 0
         self._last_newton = 0
         self._discontinuous_failures = 0
         self.discontinuous_failures_total = 0
-        self._steps_since_check = 0
         self._solver = None
         self._last_time = 0.0
         self._law_cache: tuple[bytes, np.ndarray] | None = None
-
-    # ------------------------------------------------------------------ guards
-    def _energy_guard_applies(self) -> bool:
-        kinds = {e.kind for e in self.scene.expectations}
-        if not kinds & set(ENERGY_EXPECTATIONS):
-            self.guard_notes.append("energy guard off: no energy expectation")
-            return False
-        work = sorted(set(WORK_FEATURES) & self.scene.features)
-        if work:
-            self.guard_notes.append(f"energy guard off: {', '.join(work)} not counted")
-            return False
-        self.guard_notes.append(
-            f"energy guard on: stops when energy exceeds its initial value by more than "
-            f"{self.config.energy_gain_tolerance:g} x the energy scale, checked every "
-            f"{self.config.guard_interval} steps and at every sample")
-        return True
-
-    def _size_energy_scale(self) -> float:
-        """sum(m |g|) over the moving bodies x the largest shape dimension [M L^2/T^2]."""
-        g = float(np.linalg.norm(self.gravity))
-        return float(np.sum(self.mass[self.movable])) * g * largest_shape_dimension(self.scene)
 
     # ------------------------------------------------------------------ state
     def state(self):
@@ -180,19 +153,6 @@ class Runner:
             stretch = np.linalg.norm(pb - pa) - load.rest_length
             springs += load.preload * stretch + 0.5 * load.stiffness * stretch**2
         return float(kinetic + potential + springs), float(kinetic)
-
-    def _check_energy(self, t: float, state) -> str | None:
-        total, kinetic = self.energy(state)
-        self._kinetic_max = max(self._kinetic_max, kinetic)
-        gain = total - self.energy_initial
-        scale = max(self._kinetic_max, self._size_energy, 1e-300)
-        self.energy_max_gain = max(self.energy_max_gain, gain / scale)
-        if gain > self.config.energy_gain_tolerance * scale:
-            return (f"energy gain {gain:.4g} (model units) = {gain / scale:.3g} x the energy "
-                    f"scale at t = {t:.6g}: above the tolerance "
-                    f"{self.config.energy_gain_tolerance:g} on a scene whose energy may only "
-                    "decrease")
-        return None
 
     # ------------------------------------------------------------------ read-out
     def contact_forces(self) -> tuple[np.ndarray, np.ndarray, int]:
@@ -250,7 +210,7 @@ class Runner:
         laws = self.built.law_forces
         position, _, rotation, _, _ = self.state()
         com = position + np.einsum("bij,bj->bi", rotation, self.built.bodies.com)
-        wrench = laws.wrenches(com, rotation, t)
+        wrench = laws.wrenches(t, com, rotation)
         for b, force, torque in self.built.law_loads:
             mbs.SetLoadParameter(force, "loadVector", wrench[b, :3].tolist())
             mbs.SetLoadParameter(torque, "loadVector", wrench[b, 3:].tolist())
@@ -264,7 +224,7 @@ class Runner:
             position, quaternion = self.built.bodies.poses(q)
             rotation = quat_to_matrix_batch(quaternion)
             com = position + np.einsum("bij,bj->bi", rotation, self.built.bodies.com)
-            self._law_cache = (key, self.built.law_forces.wrenches(com, rotation, t))
+            self._law_cache = (key, self.built.law_forces.wrenches(t, com, rotation))
         return self._law_cache[1]
 
     def _install_implicit_laws(self) -> None:
@@ -301,13 +261,11 @@ class Runner:
             self.built.law_forces.remember(quat_to_matrix_batch(quaternion))
         recording = (self.count < len(self.record_times)
                      and t >= self.record_times[self.count] - 1e-6 * self.dt)
-        self._steps_since_check += 1
-        checking = self._energy_guard and self._steps_since_check >= self.config.guard_interval
+        checking = self.guard.due(self.solver_steps)
         if recording or checking or problem is not None:
             state = self.state()
-            if self._energy_guard and problem is None:
-                self._steps_since_check = 0
-                problem = self._check_energy(t, state)
+            if self.guard.applies and problem is None:
+                problem = self.guard.check(*self.energy(state), t)
             if (recording or problem is not None) and not self.recorder.is_full:
                 self.store(t, state)
         self.record_seconds += time.perf_counter() - tick
@@ -326,7 +284,7 @@ class Runner:
             self.guard_notes.append("closed loop: EigenDense full-pivot LU with "
                                     "ignoreSingularJacobian (redundant constraints)")
         state = self.state()
-        self.energy_initial, self._kinetic_max = self.energy(state)
+        self.guard.start(*self.energy(state))
         self.store(0.0, state, with_contacts=False)
         mbs.SetPostStepUserFunction(self._post_step)
         if self.built.law_forces is not None:
@@ -347,12 +305,15 @@ class Runner:
                     raise exu.SolverError("InitializeSolver failed: "
                                           + solver.GetErrorString())
                 self._last_newton = int(solver.it.newtonStepsCount)
-                success = True
-                for step in range(1, self.steps + 1):
-                    solver.it.endTime = step * self.dt
+                if self.config.step_loop == "horizon":
                     success = solver.SolveSteps(mbs, s)
-                    if not success or self.problem is not None:
-                        break
+                else:
+                    success = True
+                    for step in range(1, self.steps + 1):
+                        solver.it.endTime = step * self.dt
+                        success = solver.SolveSteps(mbs, s)
+                        if not success or self.problem is not None:
+                            break
                 solver.FinalizeSolver(mbs, s)
             if self.problem is not None:
                 status, message = RunStatus.DIVERGED, self.problem

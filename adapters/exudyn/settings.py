@@ -30,6 +30,8 @@ import dataclasses
 import math
 from dataclasses import dataclass
 
+from clearbench.adapters.base import check_option_number, check_option_values, option_error
+
 #: Named presets; each is a separate engine variant ``exudyn[<preset>]`` in results.
 PRESETS: dict[str, dict] = {
     # Exudyn as it comes: generalized-alpha (spectral radius 0.9, modified Newton, adaptive
@@ -58,6 +60,7 @@ LINEAR_SOLVERS = ("EXUdense", "EigenSparse", "EigenDense")
 RING_JOURNAL_MODELS = ("hollow_sphere", "in_plane", "facets")
 LAW_LOAD_MODES = ("explicit", "implicit")
 UNIT_CHOICES = ("scene", "SI")
+STEP_LOOPS = ("horizon", "grid")
 
 
 @dataclass(frozen=True)
@@ -88,6 +91,16 @@ class ExudynSettings:
     recommended_step : bool
         Let contact connectors shorten a step so that it ends at the contact instant
         (Exudyn's ``discontinuous.useRecommendedStepSize``; needs ``adaptive_step``).
+    step_loop : {'horizon', 'grid'}
+        'horizon': one ``SolveSteps`` call over the whole run, Exudyn's step control left
+        alone (after a reduced step it grows the step back only after
+        ``adaptiveStepRecoverySteps`` good steps); a sample is the first step end at or after
+        its time, so sample times leave the grid by less than a step after a reduction.
+        'grid': one call per nominal step ending on the grid; every call restarts at the
+        nominal step (``SolveSteps`` resets ``currentStepSize``), so a contact is integrated
+        with full steps right after the instant it was localised at (bouncing ball e = 0.5,
+        1st apex: +11 % default / +36 % tuned at dt 1e-3, against -0.8 % / -0.02 % with
+        'horizon').
     linear_solver : {'EXUdense', 'EigenSparse'}
     ignore_singular_jacobian : bool
         Let the linear solver pass redundant constraints (Exudyn: only with 'EigenDense',
@@ -167,6 +180,7 @@ class ExudynSettings:
     discontinuous_max_iterations: int = 5
     discontinuous_tolerance: float = 1.0
     recommended_step: bool = True
+    step_loop: str = "horizon"
     linear_solver: str = "EXUdense"
     ignore_singular_jacobian: bool = False
     closed_loop_full_pivot: bool = True
@@ -194,63 +208,42 @@ class ExudynSettings:
     guard_interval: int = 10
 
     def __post_init__(self) -> None:
-        choices = {"solver": SOLVERS, "linear_solver": LINEAR_SOLVERS,
-                   "ring_journal": RING_JOURNAL_MODELS, "law_loads": LAW_LOAD_MODES,
-                   "internal_units": UNIT_CHOICES, "impact_model": (0, 1, 2),
-                   "stiffness_time_step": ("run", "scene")}
-        for name, allowed in choices.items():
-            if getattr(self, name) not in allowed:
-                _fail(name, getattr(self, name), f"must be one of {allowed}")
-        for name in ("adaptive_step", "modified_newton", "ignore_singular_jacobian",
-                     "closed_loop_full_pivot", "recommended_step"):
-            if not isinstance(getattr(self, name), bool):
-                _fail(name, getattr(self, name), "must be true or false")
-        integers = {"newton_max_iterations": 1, "discontinuous_max_iterations": 1,
-                    "ring_spheres": 3, "journal_facets": 3, "journal_spheres": 1,
-                    "disc_segments": 3, "guard_interval": 1}
-        for name, low in integers.items():
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or value < low:
-                _fail(name, value, f"must be an integer >= {low}")
-        positive = ("minimum_step_fraction", "newton_relative_tolerance",
-                    "newton_absolute_tolerance", "discontinuous_tolerance",
-                    "contact_period_steps", "contact_stiffness_exponent",
-                    "friction_regularisation_velocity", "plastic_restitution",
-                    "ring_sphere_radius", "facet_window", "corner_sphere_radius", "plane_size",
-                    "energy_gain_tolerance")
-        for name in positive:
-            value = getattr(self, name)
-            if not _is_real(value) or not value > 0 or not math.isfinite(value):
-                _fail(name, value, "must be a finite number > 0")
-        for name in ("contact_damping_ratio", "minimum_impact_velocity"):
-            value = getattr(self, name)
-            if not _is_real(value) or not value >= 0 or not math.isfinite(value):
-                _fail(name, value, "must be a finite number >= 0")
-        if not _is_real(self.spectral_radius) or not 0.0 <= self.spectral_radius <= 1.0:
-            _fail("spectral_radius", self.spectral_radius, "must be in [0, 1]")
+        check_option_values(
+            "exudyn", self,
+            choices={"solver": SOLVERS, "linear_solver": LINEAR_SOLVERS,
+                     "ring_journal": RING_JOURNAL_MODELS, "law_loads": LAW_LOAD_MODES,
+                     "internal_units": UNIT_CHOICES, "impact_model": (0, 1, 2),
+                     "stiffness_time_step": ("run", "scene"), "step_loop": STEP_LOOPS},
+            booleans=("adaptive_step", "modified_newton", "ignore_singular_jacobian",
+                      "closed_loop_full_pivot", "recommended_step"),
+            integers={"newton_max_iterations": 1, "discontinuous_max_iterations": 1,
+                      "ring_spheres": 3, "journal_facets": 3, "journal_spheres": 1,
+                      "disc_segments": 3, "guard_interval": 1},
+            positive=("minimum_step_fraction", "newton_relative_tolerance",
+                      "newton_absolute_tolerance", "discontinuous_tolerance",
+                      "contact_period_steps", "contact_stiffness_exponent",
+                      "friction_regularisation_velocity", "plastic_restitution",
+                      "ring_sphere_radius", "facet_window", "corner_sphere_radius", "plane_size",
+                      "energy_gain_tolerance"),
+            non_negative=("contact_damping_ratio", "minimum_impact_velocity"))
+        check_option_number("exudyn", "spectral_radius", self.spectral_radius, 0.0, 1.0)
         if not self.plastic_restitution <= 1.0:
             _fail("plastic_restitution", self.plastic_restitution, "must be in (0, 1]")
         if not self.minimum_step_fraction < 1.0:
             _fail("minimum_step_fraction", self.minimum_step_fraction, "must be < 1")
         if self.facet_window > math.pi:
             _fail("facet_window", self.facet_window, "must be <= pi")
-        if self.contact_stiffness is not None and (
-                not _is_real(self.contact_stiffness) or not self.contact_stiffness > 0
-                or not math.isfinite(self.contact_stiffness)):
-            _fail("contact_stiffness", self.contact_stiffness,
-                  "must be a finite number > 0 (or None for the rule)")
+        if self.contact_stiffness is not None:
+            check_option_number("exudyn", "contact_stiffness", self.contact_stiffness, 0.0,
+                                strict=True)
 
     def as_dict(self) -> dict:
         """Plain-dict form for trajectory metadata."""
         return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
 
 
-def _is_real(value) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool)
-
-
 def _fail(name: str, value, reason: str) -> None:
-    raise ValueError(f"exudyn option {name}={value!r}: {reason}")
+    raise option_error("exudyn", name, value, reason)
 
 
 OPTION_NAMES = tuple(f.name for f in dataclasses.fields(ExudynSettings))

@@ -14,16 +14,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from clearbench.adapters.force_elements import (
+    LAW_KINDS,
     ForceElements,
     law_load_problems,
     scene_force_elements,
 )
-from clearbench.ref_solver.system import FORCE_ANGLE_LAW, FORCE_DISTANCE_LAW
 from clearbench.scenarios.scene import Scene
 
 __all__ = ["LAW_KINDS", "LawForces", "law_forces", "law_load_problems"]
-
-LAW_KINDS = (FORCE_ANGLE_LAW, FORCE_DISTANCE_LAW)
 
 
 @dataclass

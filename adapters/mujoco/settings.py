@@ -20,6 +20,8 @@ import dataclasses
 import math
 from dataclasses import dataclass
 
+from clearbench.adapters.base import check_option_values
+
 #: MuJoCo's own defaults (mjOption and the default geom solref/solimp of MuJoCo 3/4).
 MUJOCO_DEFAULT_SOLREF = (0.02, 1.0)
 MUJOCO_DEFAULT_SOLIMP = (0.9, 0.95, 0.001, 0.5, 2.0)
@@ -153,17 +155,18 @@ class MujocoSettings:
     ccd_tolerance_relative: float | None = None
 
     def __post_init__(self) -> None:
-        choices = {
-            "integrator": ("Euler", "implicit", "implicitfast", "RK4"),
-            "cone": ("pyramidal", "elliptic"),
-            "solver": ("Newton", "CG", "PGS"),
-            "ring_piece": ("sphere", "capsule", "box"),
-            "internal_units": ("SI", "scene"),
-        }
-        for name, allowed in choices.items():
-            if getattr(self, name) not in allowed:
-                raise ValueError(f"mujoco option {name}={getattr(self, name)!r}: "
-                                 f"must be one of {allowed}")
+        check_option_values(
+            "mujoco", self,
+            choices={"integrator": ("Euler", "implicit", "implicitfast", "RK4"),
+                     "cone": ("pyramidal", "elliptic"), "solver": ("Newton", "CG", "PGS"),
+                     "ring_piece": ("sphere", "capsule", "box"),
+                     "internal_units": ("SI", "scene")},
+            integers={"ring_pieces": 3, "bore_pieces": 3, "iterations": 1,
+                      "guard_interval": 1, "noslip_iterations": 0},
+            positive=("impratio", "tolerance", "restitution_contact_steps",
+                      "plastic_damping_ratio", "ring_piece_radius", "bore_wall",
+                      "face_thickness", "plane_box_size", "driver_armature_ratio",
+                      "energy_gain_tolerance"))
         for name in ("solref", "equality_solref"):
             value = tuple(float(x) for x in getattr(self, name))
             if len(value) != 2:
@@ -174,18 +177,6 @@ class MujocoSettings:
             if len(value) != 5:
                 raise ValueError(f"mujoco option {name}={value!r}: needs 5 numbers")
             object.__setattr__(self, name, value)
-        for name in ("ring_pieces", "bore_pieces"):
-            if getattr(self, name) < 3:
-                raise ValueError(f"mujoco option {name}={getattr(self, name)}: must be >= 3")
-        positive = ("impratio", "tolerance", "restitution_contact_steps", "plastic_damping_ratio",
-                    "ring_piece_radius", "bore_wall", "face_thickness", "plane_box_size",
-                    "driver_armature_ratio", "energy_gain_tolerance")
-        for name in positive:
-            if not getattr(self, name) > 0:
-                raise ValueError(f"mujoco option {name}={getattr(self, name)!r}: must be > 0")
-        if self.iterations < 1 or self.guard_interval < 1 or self.noslip_iterations < 0:
-            raise ValueError("mujoco options iterations and guard_interval must be >= 1, "
-                             "noslip_iterations >= 0")
 
     def as_dict(self) -> dict:
         """Plain-dict form for trajectory metadata."""

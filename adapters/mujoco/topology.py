@@ -26,12 +26,12 @@ import.
 
 from __future__ import annotations
 
-from collections import deque
 from dataclasses import dataclass
 
 from clearbench.adapters.joint_tree import (
     DrivenDof,
-    axis_sign,
+    breadth_first_edges,
+    plan_drivers,
     rotations_held,
     split_joint_graph,
 )
@@ -91,19 +91,10 @@ def plan_topology(scene: Scene) -> Topology:
     closures = graph.closures
     links: list[TreeLink] = []
     visited: set[str] = set()
-    queue: deque[str] = deque()
 
     def visit_from(start: str) -> None:
-        queue.append(start)
-        while queue:
-            current = queue.popleft()
-            for joint, other in adjacency[current]:
-                if other in visited:
-                    continue
-                visited.add(other)
-                kind = TREE_JOINT[joint.kind] or "weld"
-                links.append(TreeLink(other, current, kind, joint.name))
-                queue.append(other)
+        for parent, joint, child in breadth_first_edges(adjacency, [start], visited):
+            links.append(TreeLink(child, parent, TREE_JOINT[joint.kind] or "weld", joint.name))
 
     for body in scene.bodies:
         if body.name in fixed:
@@ -130,35 +121,14 @@ def plan_topology(scene: Scene) -> Topology:
             reason = (f"prismatic joint {joint.name!r} closes a loop: no MuJoCo equality "
                       "constraint leaves exactly one sliding freedom")
             problems += [("closed_loop", reason), ("joint:prismatic", reason)]
-    driven, driver_problems = _plan_drivers(scene, links, fixed, drivers_of)
+    driven, driver_problems = plan_drivers(
+        scene, drivers_of,
+        {link.body for link in links
+         if link.kind in ("translation_driven", "translation_driven_held")},
+        {link.body: link.joint for link in links
+         if link.kind in ("hinge", "slide") and link.parent in fixed},
+        "MuJoCo")
     problems += driver_problems
     return Topology(tuple(links), tuple(j.name for j in closures), driven, tuple(problems),
                     graph.ignored)
 
-
-def _plan_drivers(scene: Scene, links: list, fixed: set, drivers_of: dict):
-    joints = {j.name: j for j in scene.joints}
-    by_body = {link.body: link for link in links}
-    driven: dict[str, tuple] = {}
-    problems = []
-    for body, drivers in drivers_of.items():
-        link = by_body[body]
-        components = ", ".join(d.component for d in drivers)
-        if link.kind in ("translation_driven", "translation_driven_held"):
-            # Held rotations have no joint: the orientation cannot change (exact).
-            driven[body] = tuple(DrivenDof(d, f"slide_{d.component}") for d in drivers
-                                 if not d.is_rotation)
-            continue
-        if link.kind in ("hinge", "slide") and link.parent in fixed and len(drivers) == 1:
-            sign = axis_sign(joints[link.joint], drivers[0])
-            if sign is not None:
-                driven[body] = (DrivenDof(drivers[0], "tree", sign),)
-                continue
-        problems.append((
-            "drivers",
-            f"body {body!r} (drivers on {components}): MuJoCo can prescribe a component only as "
-            "its own joint: one rotation (translation) by a hinge (slide) to a fixed body "
-            "about (along) that world axis, or translations of a body with no ideal joint (its "
-            "rotations undriven, or all three held at zero)",
-        ))
-    return driven, problems

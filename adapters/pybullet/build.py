@@ -25,7 +25,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pybullet as pb
 
 from clearbench.adapters.force_elements import scene_force_elements
 from clearbench.adapters.pybullet.dynamics import (
@@ -47,6 +46,7 @@ from clearbench.adapters.pybullet.geometry import (
     collision_margin,
     side_geometry,
 )
+from clearbench.adapters.pybullet.library import pb
 from clearbench.adapters.pybullet.settings import PybulletSettings
 from clearbench.adapters.pybullet.shapes import create_shape, object_frame
 from clearbench.adapters.pybullet.topology import LinkPlan, TreePlan, plan_topology

@@ -6,8 +6,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pybullet as pb
 
+from clearbench.adapters.pybullet.library import pb
 from clearbench.adapters.pybullet.world import BuiltWorld
 
 

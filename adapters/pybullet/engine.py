@@ -46,7 +46,8 @@ AUTO_MILLIMETRE_BELOW = 1e-3
 def availability() -> tuple[bool, str]:
     """(available, detail) of the pybullet package; never raises."""
     try:
-        import pybullet  # noqa: F401  lazy import of the engine package: only when asked
+        # lazy import of the engine package (only when asked), without its build-time banner
+        from clearbench.adapters.pybullet.library import pb  # noqa: F401
     except ImportError as error:  # pragma: no cover - pybullet is a dependency
         return False, f"pybullet does not import: {error}"
     try:

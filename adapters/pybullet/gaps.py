@@ -10,10 +10,9 @@ from __future__ import annotations
 
 import math
 
-import pybullet as pb
-
 from clearbench.adapters.pybullet.build import build_world, disconnect
 from clearbench.adapters.pybullet.engine import internal_scene
+from clearbench.adapters.pybullet.library import pb
 from clearbench.adapters.pybullet.settings import resolve_settings
 from clearbench.scenarios.geometry import UnsupportedPairError, contacts_between
 from clearbench.scenarios.scene import Scene

@@ -25,10 +25,10 @@ import logging
 import time
 
 import numpy as np
-import pybullet as pb
 
-from clearbench.adapters.energy_guard import WORK_FEATURES, EnergyGuard
+from clearbench.adapters.energy_guard import SPRING_WORK_FEATURES, EnergyGuard
 from clearbench.adapters.pybullet.frames import from_pb
+from clearbench.adapters.pybullet.library import pb
 from clearbench.adapters.pybullet.world import BuiltWorld
 from clearbench.adapters.recording import SampleRecorder
 from clearbench.adapters.trajectory import RunStatus
@@ -37,11 +37,6 @@ from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.loads import LinearSpringDamper
 
 logger = logging.getLogger(__name__)
-
-#: Work the energy of :meth:`Runner.energy` does not count: the shared list, and torsional
-#: springs (their potential is not summed here).
-UNCOUNTED_WORK = (*WORK_FEATURES, "torsional_springs")
-
 
 class Runner:
     """The step loop of one run: drivers, loads, guards, and sampling into arrays."""
@@ -66,7 +61,7 @@ class Runner:
         self.max_contacts = 0
         self._springs = [load for load in scene.loads if isinstance(load, LinearSpringDamper)]
         self.guard = EnergyGuard(scene, self.config.energy_gain_tolerance,
-                                 self.config.guard_interval, UNCOUNTED_WORK)
+                                 self.config.guard_interval, SPRING_WORK_FEATURES)
         # Static bodies never move: their poses are the scene's.
         self._static_pose = {i: (np.asarray(b.position, float),
                                  np.asarray(b.orientation, float) / np.linalg.norm(

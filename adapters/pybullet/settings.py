@@ -40,8 +40,9 @@ not a physical choice but a trap, and the run stops with a guard when one is lef
 from __future__ import annotations
 
 import dataclasses
-import math
 from dataclasses import dataclass
+
+from clearbench.adapters.base import check_option_number, check_option_values
 
 #: Compound shapes of PyBullet keep at most this many children (MAX_COMPOUND_COLLISION_SHAPES of
 #: SharedMemoryCommands.h); more are dropped silently (docs/engines/pybullet.md).
@@ -204,33 +205,21 @@ class PybulletSettings:
     guard_interval: int = 10
 
     def __post_init__(self) -> None:
-        choices = {"body_model": ("multibody", "rigid"),
-                   "internal_units": ("SI", "scene", "mm-g-ms", "auto")}
-        for name, allowed in choices.items():
-            if getattr(self, name) not in allowed:
-                _fail(name, getattr(self, name), f"must be one of {allowed}")
-        booleans = ("use_split_impulse", "enable_cone_friction",
-                    "deterministic_overlapping_pairs", "friction_anchor",
-                    "switch_off_joint_motors")
-        for name in booleans:
-            if not isinstance(getattr(self, name), bool):
-                _fail(name, getattr(self, name), "must be true or false")
-        integers = {"num_solver_iterations": 1, "ring_pieces": 3, "bore_pieces": 3,
-                    "guard_interval": 1}
-        for name, least in integers.items():
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or value < least:
-                _fail(name, value, f"must be an integer >= {least}")
-        positive = ("erp", "contact_breaking_threshold", "ring_piece_radius",
-                    "bore_piece_radius", "face_thickness", "plane_box_size", "driver_max_force",
-                    "energy_gain_tolerance")
-        for name in positive:
-            _check_number(name, getattr(self, name), lower=0.0, strict=True)
-        non_negative = ("solver_residual_threshold", "warm_starting_factor", "contact_erp",
-                        "friction_erp", "global_cfm", "contact_slop",
-                        "restitution_velocity_threshold")
-        for name in non_negative:
-            _check_number(name, getattr(self, name), lower=0.0)
+        check_option_values(
+            "pybullet", self,
+            choices={"body_model": ("multibody", "rigid"),
+                     "internal_units": ("SI", "scene", "mm-g-ms", "auto")},
+            booleans=("use_split_impulse", "enable_cone_friction",
+                      "deterministic_overlapping_pairs", "friction_anchor",
+                      "switch_off_joint_motors"),
+            integers={"num_solver_iterations": 1, "ring_pieces": 3, "bore_pieces": 3,
+                      "guard_interval": 1},
+            positive=("erp", "contact_breaking_threshold", "ring_piece_radius",
+                      "bore_piece_radius", "face_thickness", "plane_box_size",
+                      "driver_max_force", "energy_gain_tolerance"),
+            non_negative=("solver_residual_threshold", "warm_starting_factor", "contact_erp",
+                          "friction_erp", "global_cfm", "contact_slop",
+                          "restitution_velocity_threshold"))
         for name in ("erp", "contact_erp", "friction_erp", "warm_starting_factor"):
             _check_number(name, getattr(self, name), upper=1.0)
         _check_number("split_impulse_penetration_threshold",
@@ -254,19 +243,10 @@ class PybulletSettings:
         return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
 
 
-def _fail(name: str, value, why: str) -> None:
-    raise ValueError(f"pybullet option {name}={value!r}: {why}")
-
-
 def _check_number(name: str, value, lower: float | None = None, upper: float | None = None,
                   strict: bool = False) -> None:
     """A finite real number within the bounds (ValueError naming the option and value)."""
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        _fail(name, value, "must be a finite number")
-    if lower is not None and (value <= lower if strict else value < lower):
-        _fail(name, value, f"must be {'>' if strict else '>='} {lower:g}")
-    if upper is not None and value > upper:
-        _fail(name, value, f"must be <= {upper:g}")
+    check_option_number("pybullet", name, value, lower, upper, strict)
 
 
 OPTION_NAMES = tuple(f.name for f in dataclasses.fields(PybulletSettings))

@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import numpy as np
-import pybullet as pb
 
 from clearbench.adapters.pybullet.frames import IDENTITY, to_pb
 from clearbench.adapters.pybullet.geometry import check_compound
+from clearbench.adapters.pybullet.library import pb
 
 
 def create_shape(client: int, pieces: tuple) -> int:

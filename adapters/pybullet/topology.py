@@ -32,12 +32,12 @@ when all three rotations are driven and held at zero). Pure Python.
 
 from __future__ import annotations
 
-from collections import deque
 from dataclasses import dataclass
 
 from clearbench.adapters.joint_tree import (
     DrivenDof,
-    axis_sign,
+    breadth_first_edges,
+    plan_drivers,
     rotations_held,
     split_joint_graph,
 )
@@ -111,16 +111,9 @@ def plan_topology(scene: Scene, body_model: str, collision_objects: dict[str, in
 
     def grow(start_links: list[LinkPlan], starts: list[str], fixed_base: bool) -> None:
         links = list(start_links)
-        queue = deque(starts)
-        while queue:
-            current = queue.popleft()
-            for joint, other in adjacency[current]:
-                if other in visited:
-                    continue
-                visited.add(other)
-                link_parent = None if current in fixed else current
-                links.append(LinkPlan(other, link_parent, joint.kind, joint.name))
-                queue.append(other)
+        for parent, joint, child in breadth_first_edges(adjacency, starts, visited):
+            links.append(LinkPlan(child, None if parent in fixed else parent, joint.kind,
+                                  joint.name))
         if links:
             trees.append(TreePlan(fixed_base, tuple(links)))
 
@@ -142,38 +135,14 @@ def plan_topology(scene: Scene, body_model: str, collision_objects: dict[str, in
             continue
         grow([LinkPlan(body.name, None, "base")], [body.name], False)
 
-    problems = []
-    driven, driver_problems = _plan_drivers(scene, trees, fixed, drivers_of)
-    problems += driver_problems
+    links = [link for tree in trees for link in tree.links]
+    driven, problems = plan_drivers(
+        scene, drivers_of,
+        {link.body for link in links if link.kind in ("translation", "translation_held")},
+        {link.body: link.joint for link in links
+         if link.kind in ("revolute", "prismatic") and link.parent is None},
+        "PyBullet")
     return Topology(tuple(sorted(fixed)), tuple(rigid), tuple(trees),
                     tuple(j.name for j in graph.closures), driven, tuple(problems),
                     graph.ignored)
 
-
-def _plan_drivers(scene: Scene, trees, fixed, drivers_of: dict):
-    joints = {j.name: j for j in scene.joints}
-    links = {link.body: link for tree in trees for link in tree.links}
-    driven: dict[str, tuple] = {}
-    problems = []
-    for body, drivers in drivers_of.items():
-        link = links.get(body)
-        components = ", ".join(d.component for d in drivers)
-        if link is not None and link.kind in ("translation", "translation_held"):
-            driven[body] = tuple(DrivenDof(d, f"slide_{d.component}") for d in drivers
-                                 if not d.is_rotation)
-            continue
-        if (link is not None and link.kind in ("revolute", "prismatic") and link.parent is None
-                and len(drivers) == 1):
-            # The link's joint axis is the scene joint's axis (world, initial pose): the
-            # coordinate is the link body's rotation (translation) about (along) it.
-            sign = axis_sign(joints[link.joint], drivers[0])
-            if sign is not None:
-                driven[body] = (DrivenDof(drivers[0], "tree", sign),)
-                continue
-        problems.append((
-            "drivers",
-            f"body {body!r} (drivers on {components}): PyBullet can prescribe a component only "
-            "as a joint coordinate of its own: one rotation (translation) by a revolute "
-            "(prismatic) joint to a fixed body about (along) that world axis, or translations of "
-            "a body with no ideal joint (rotations undriven, or all three held at zero)"))
-    return driven, problems

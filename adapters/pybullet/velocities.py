@@ -4,8 +4,8 @@ through the velocity coordinates of rigid bodies, floating bases and joints."""
 from __future__ import annotations
 
 import numpy as np
-import pybullet as pb
 
+from clearbench.adapters.pybullet.library import pb
 from clearbench.adapters.pybullet.world import BuiltWorld
 from clearbench.kernels.quaternion import quat_to_matrix
 

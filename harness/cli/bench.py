@@ -8,17 +8,19 @@ and a function that measures (with :mod:`clearbench.harness.studies.benchmarks`)
 from __future__ import annotations
 
 import argparse
+import importlib
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from clearbench.adapters import engine_availability, mujoco, siconos
-from clearbench.adapters import reference as reference_engine
+from clearbench.adapters import siconos
 from clearbench.harness.cli import bench_against
-from clearbench.harness.cli.common import UserError
+from clearbench.harness.cli.common import UserError, assignments
+from clearbench.harness.run.engine_choice import RunInputError, resolve_engine
 from clearbench.harness.studies.benchmarks import (
     clearance_ladder,
+    contact_cost,
     kernel_speed,
     physics,
     physics_table,
@@ -188,9 +190,8 @@ def bench_clearance_ladder(args: argparse.Namespace) -> int:
 
 
 # ---------------------------------------------------------------------------- other engines
-def _mujoco_table_options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--preset", action="append", dest="presets",
-                        help="MuJoCo preset (repeatable; default: default and tuned)")
+def _table_options(parser: argparse.ArgumentParser) -> None:
+    """Options shared by ``physics-table`` and ``mujoco-table``."""
     parser.add_argument("--dt", action="append", type=float, dest="time_steps",
                         help="time step [s] (repeatable; default: 1e-3 and 1e-4)")
     parser.add_argument("--scene", action="append", dest="scenes",
@@ -202,21 +203,61 @@ def _mujoco_table_options(parser: argparse.ArgumentParser) -> None:
                         help="add the reference solver (default preset) as a column")
     parser.add_argument("--compact", action="store_true",
                         help="one table for all scenes (a row per scene and figure)")
+    _engine_option(parser)
+
+
+def _engine_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--option", action="append", default=[], metavar="KEY=VALUE",
+                        help="engine option over every preset of the table (repeatable; "
+                        "checked by each engine before any run)")
+
+
+def _physics_table_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--engine", "-e", action="append", dest="engines",
+                        metavar="ENGINE[PRESET]",
+                        help="engine and preset, e.g. 'pybullet[tuned]' (repeatable; a column "
+                        "per engine and time step)")
+    _table_options(parser)
+
+
+def _mujoco_table_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--preset", action="append", dest="presets",
+                        help="MuJoCo preset (repeatable; default: default and tuned)")
+    _table_options(parser)
     parser.add_argument("--no-mujoco", action="store_true",
                         help="leave out the MuJoCo columns (with --reference: the reference "
                         "column alone)")
 
 
-def bench_mujoco_table(args: argparse.Namespace) -> int:
-    available = engine_availability("mujoco")
-    if not available.available:
-        raise UserError(f"mujoco is not available: {available.detail}")
-    presets = args.presets or ["default", "tuned"]
-    for preset in presets:   # the engine's own preset check, before any run
+def _engines(labels: list[str], options: dict) -> dict:
+    """``ENGINE[PRESET]`` labels -> created engines, each checked (known, available, preset,
+    the names of ``options``) before any run; UserError (exit 2) naming the bad value."""
+    if not labels:
+        raise UserError("nothing to run: give --engine ENGINE[PRESET] (or --reference)")
+    engines = {}
+    for label in labels:
         try:
-            mujoco.MujocoEngine(preset)
-        except ValueError as error:
+            choice = resolve_engine(label, options=options, field="--engine")
+        except RunInputError as error:
             raise UserError(str(error)) from None
+        engine = importlib.import_module(choice.module).create(choice.preset)
+        resolve_settings = getattr(engine, "settings", None)  # engines with a settings object
+        if options and callable(resolve_settings):
+            try:
+                resolve_settings(options)  # the option values, checked by the engine
+            except ValueError as error:
+                raise UserError(f"--option: {error}") from None
+        engines[label if label == "reference" else choice.label] = engine
+    return engines
+
+
+def _print_physics_table(labels: list[str], args: argparse.Namespace) -> int:
+    """Check the engine labels, scenes and steps of a table (exit 2 naming the bad value, before
+    any run), run every cell and print the Markdown."""
+    if args.reference:
+        labels = [*labels, "reference"]
+    options = assignments(args.option, "--option")
+    engines = _engines(labels, options)
     scenes = tuple(args.scenes or physics_table.DEFAULT_SCENES)
     missing = sorted(set(scenes) - set(scene_names()))
     if missing:
@@ -224,16 +265,56 @@ def bench_mujoco_table(args: argparse.Namespace) -> int:
     time_steps = tuple(args.time_steps or (1e-3, 1e-4))
     if any(not dt > 0 for dt in time_steps):
         raise UserError(f"--dt must be > 0, got {time_steps}")
-    engines = {} if args.no_mujoco else {f"mujoco[{p}]": mujoco.create(p) for p in presets}
-    if not engines and not args.reference:
-        raise UserError("nothing to run: --no-mujoco without --reference")
-    if args.reference:
-        engines["reference"] = reference_engine.create()
+    if args.horizon is not None and not args.horizon > 0:
+        raise UserError(f"--horizon must be > 0, got {args.horizon}")
     measured = physics_table.measure(
         engines, time_steps, scenes, args.horizon,
-        progress=lambda text: print(f"running {text}", file=sys.stderr))
+        progress=lambda text: print(f"running {text}", file=sys.stderr, flush=True),
+        options=options)
     print(physics_table.markdown_compact(measured) if args.compact
           else physics_table.markdown(measured))
+    return 0
+
+
+def bench_physics_table(args: argparse.Namespace) -> int:
+    return _print_physics_table(list(args.engines or []), args)
+
+
+def bench_mujoco_table(args: argparse.Namespace) -> int:
+    presets = [] if args.no_mujoco else (args.presets or ["default", "tuned"])
+    if args.no_mujoco and not args.reference:
+        raise UserError("nothing to run: --no-mujoco without --reference")
+    return _print_physics_table([f"mujoco[{preset}]" for preset in presets], args)
+
+
+def _contact_cost_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--engine", "-e", action="append", dest="engines",
+                        metavar="ENGINE[PRESET]", help="engine and preset (repeatable)")
+    parser.add_argument("--boxes", action="append", type=int,
+                        help="box count (repeatable; default: 1 4 9 16 26)")
+    parser.add_argument("--dt", action="append", type=float, dest="time_steps",
+                        help="time step [s] (repeatable; default: 1e-3 and 1e-4)")
+    parser.add_argument("--horizon", type=float, default=contact_cost.DEFAULT_HORIZON,
+                        help="simulated duration [s] (default 0.05: the 1 mm drop and settling)")
+    _engine_option(parser)
+
+
+def bench_contact_cost(args: argparse.Namespace) -> int:
+    boxes = tuple(args.boxes or contact_cost.DEFAULT_BOXES)
+    if any(count < 1 for count in boxes):
+        raise UserError(f"--boxes must be >= 1, got {boxes}")
+    time_steps = tuple(args.time_steps or (1e-3, 1e-4))
+    if any(not dt > 0 for dt in time_steps) or not args.horizon > 0:
+        raise UserError(f"--dt and --horizon must be > 0, got {time_steps}, {args.horizon}")
+    options = assignments(args.option, "--option")
+    engines = _engines(list(args.engines or []), options)
+    rows = contact_cost.contact_costs(
+        engines, boxes, time_steps, args.horizon,
+        progress=lambda text: print(f"running {text}", file=sys.stderr, flush=True),
+        options=options)
+    print(f"box_grid(count) for {args.horizon:g} s: wall time and solver iterations per "
+          "nominal step (and the engine's own steps where it reports them)")
+    print(contact_cost.markdown(rows))
     return 0
 
 
@@ -276,10 +357,22 @@ BENCHMARKS: dict[str, Benchmark] = {
     "fc3d-sweep": Benchmark("us per contact per NSGS sweep on the shipped FCLIB problems",
                             bench_fc3d_sweep, _fc3d_sweep_options),
     "geometry": Benchmark("ns per pair_contacts call, from inside a numba loop", bench_geometry),
+    "physics-table": Benchmark(
+        "an engine's error against physics on the analytic scenes (per engine[preset] and dt)",
+        bench_physics_table, _physics_table_options,
+        "Run every analytic scene (and the clearance pendulum) in each --engine ENGINE[PRESET] "
+        "at each time step, and print, per scene, the figures of the shared expectation "
+        "evaluator (apex errors, creep, energy drift, clearance excess, ...) and the stepping "
+        "time per step as Markdown tables; engine, preset, scene and step are checked before "
+        "any run. With --reference, the reference solver runs the same cells."),
+    "contact-cost": Benchmark(
+        "cost per step as contacts grow (box_grid, per engine[preset] and dt)",
+        bench_contact_cost, _contact_cost_options),
     "mujoco-table": Benchmark(
-        "MuJoCo's error against physics on the analytic scenes (per preset and dt)",
+        "physics-table for MuJoCo's presets (default and tuned unless --preset)",
         bench_mujoco_table, _mujoco_table_options,
-        "Run every analytic scene (and the clearance pendulum) in MuJoCo with each preset at "
+        "physics-table with --engine mujoco[PRESET] for each --preset: run every analytic "
+        "scene (and the clearance pendulum) in MuJoCo with each preset at "
         "each time step, and print, per scene, the figures of the shared expectation evaluator "
         "(apex ratios, creep, energy drift, clearance excess, ...) as Markdown tables. With "
         "--reference, the reference solver runs the same cells."),

@@ -10,8 +10,8 @@
 - :mod:`.physics`: the reference engine against physics (expectation figures, impact
   localisation, the Flores slider-crank, scale invariance);
 - :mod:`.clearance_ladder`: the clearance pendulum approaching the ideal pendulum;
-- :mod:`.physics_table`: any engine's error against physics as Markdown tables (the MuJoCo
-  table);
+- :mod:`.physics_table`: any engine's error against physics as Markdown tables;
+- :mod:`.contact_cost`: any engine's cost per step as simultaneous contacts grow;
 - :mod:`.siconos_crosscheck`: the reference solver against Siconos at equal steps.
 
 To add a benchmark: a function here that returns rows (frozen dataclasses), and an entry in

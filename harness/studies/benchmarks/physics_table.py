@@ -1,9 +1,11 @@
 """Error of an engine against the physics expectations of the analytic scenes, as Markdown
-tables (``clearbench bench mujoco-table``).
+tables (``clearbench bench physics-table --engine NAME[PRESET]``; ``mujoco-table`` is its MuJoCo
+case).
 
 Every figure comes from :func:`clearbench.harness.measure.expectation_figures.evaluate`, the
-evaluator every engine is judged by, so a MuJoCo column and a reference-solver column are computed
-by the same code. This module only chooses which figures to show and in which display unit.
+evaluator every engine is judged by, so the columns of every engine and of the reference solver
+are computed by the same code. This module only chooses which figures to show and in which
+display unit.
 """
 
 from __future__ import annotations
@@ -54,7 +56,7 @@ TABLE_FIGURES: dict[str, tuple[Figure, ...]] = {
                                      100, "%"),),
 }
 
-#: Scenes of the MuJoCo table: the analytic library plus the clearance pendulum.
+#: Scenes of the tables: the analytic library plus the clearance pendulum.
 DEFAULT_SCENES = tuple(scene_names("analytic")) + ("clearance-pendulum",)
 
 
@@ -70,15 +72,17 @@ class Cell:
 
 
 def run_cell(engine: Engine, scene: Scene, time_step: float,
-             horizon: float | None = None) -> Cell:
-    """Run ``scene`` at ``time_step`` and evaluate its expectations.
+             horizon: float | None = None, options: dict | None = None) -> Cell:
+    """Run ``scene`` at ``time_step`` (with the engine ``options`` over its preset) and
+    evaluate its expectations.
 
     Samples are kept every ``scene.time_step`` (or every step when finer), so that the
     evaluator costs the same at every time step.
     """
     record_every = max(1, round(scene.time_step / time_step))
     trajectory = engine.run(scene, RunSettings(time_step=time_step, horizon=horizon,
-                                               record_every=record_every))
+                                               record_every=record_every,
+                                               options=dict(options or {})))
     figures = {}
     if len(trajectory.times) >= 2:
         for result in evaluate(scene, trajectory):
@@ -119,9 +123,10 @@ def format_value(value: float, cell: Cell) -> str:
 
 def measure(engines: dict[str, Engine], time_steps: tuple[float, ...],
             scenes: tuple[str, ...] = DEFAULT_SCENES, horizon: float | None = None,
-            progress=None) -> list[dict]:
-    """Run every (scene, engine, time step); per scene a dict with its name, column labels,
-    rows and the cells. ``progress(text)`` is called before each run."""
+            progress=None, options: dict | None = None) -> list[dict]:
+    """Run every (scene, engine, time step), with the engine ``options`` over each preset; per
+    scene a dict with its name, column labels, rows and the cells. ``progress(text)`` is called
+    before each run."""
     out = []
     for name in scenes:
         scene = get_scene(name)
@@ -130,7 +135,7 @@ def measure(engines: dict[str, Engine], time_steps: tuple[float, ...],
             for time_step in time_steps:
                 if progress:
                     progress(f"{name} {label} dt={time_step:g}")
-                cells.append(run_cell(engine, scene, time_step, horizon))
+                cells.append(run_cell(engine, scene, time_step, horizon, options))
                 labels.append(f"{label} dt={time_step:g}")
         out.append({"scene": name, "labels": labels, "rows": table_rows(scene, cells),
                     "cells": cells})
