@@ -35,8 +35,9 @@ from clearbench.harness.report.figures import c60_work_precision_figure
 FIGURE_TITLE = "C-60 work-precision"
 FIGURE_CAPTION = ("Error of FC-1 (c60-on) and of the opening time (c60-trip) against the "
                   "reference at its finest step, over stepping wall time per run; one colour "
-                  "and marker per engine, labels are steps [ms], circles the Pareto front. Look "
-                  "for the lines below the dotted 1 % line and how far right they sit.")
+                  "and marker per engine, labels are steps [ms], circles the Pareto front (the "
+                  "reference's fine run is the zero of the error, not drawn). Look for the "
+                  "points below the dotted 1 % line and how far right they sit.")
 
 
 @dataclass
