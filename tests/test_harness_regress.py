@@ -159,3 +159,19 @@ def test_regress_covers_one_quick_scene_per_available_engine(tmp_path):
     assert len(lines) == 1 and lines[0].startswith(f"{ident}: penetration_max 1 -> ")
     assert lines[0].endswith(f"[engine version changed: older -> "
                              f"{results[ident]['engine_version']}]")
+
+
+def test_a_run_that_timed_out_is_one_status_line_without_a_version():
+    baseline = {"tolerances": {"default": {"abs": 0.0, "rel": 1e-6}},
+                "results": {"siconos[default] pendulum": {
+                    "status": "ok", "expectations_passed": 1, "engine_version": "siconos 4.4",
+                    "metrics": {"x": 1.0, "y": 2.0}}}}
+    results = {"siconos[default] pendulum": {
+        "status": "timed_out", "expectations_passed": None, "engine": "siconos[default]",
+        "engine_version": "", "message": "wall-clock limit of 300 s reached", "metrics": {}}}
+    lines = compare(baseline, results).regressions
+    assert lines == [
+        "siconos[default] pendulum: status ok -> timed_out (wall-clock limit of 300 s reached) "
+        "[engine siconos 4.4 in the baseline; this run reported no version]",
+        "siconos[default] pendulum: expectations passed 1 -> None "
+        "[engine siconos 4.4 in the baseline; this run reported no version]"]

@@ -246,6 +246,8 @@ def version_note(base: dict, new: dict) -> str:
     old, now = base.get("engine_version") or "", new.get("engine_version") or ""
     if not old:
         return ""
+    if not now:   # a run that timed out or crashed before the engine said its version
+        return f" [engine {old} in the baseline; this run reported no version]"
     if old == now:
         return f" [engine {old} unchanged]"
     return f" [engine version changed: {old} -> {now or 'unknown'}]"
@@ -279,6 +281,8 @@ def compare(baseline: dict, results: dict[str, dict],
                                        f"{base.get('expectations_passed')} -> "
                                        f"{new['expectations_passed']}")
         for metric, base_value in sorted(base.get("metrics", {}).items()):
+            if not new["metrics"] and new["status"] != base["status"]:
+                break   # the changed status says it: no figure was measured
             tolerance = tolerance_for(baseline, metric, engine)
             if metric not in new["metrics"]:
                 outcome.regressions.append(f"{ident}: {metric} no longer computed")
