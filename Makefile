@@ -28,7 +28,7 @@ test: $(STAMP) lint siconos chromium
 regress: $(STAMP)
 	$(VENV)/bin/clearbench regress
 
-ci: test regress
+ci: test regress demo
 
 # Debian's chromium, for the test that opens the report in a headless browser; never fails the
 # build (the test skips, saying why, where it cannot be installed).

@@ -93,3 +93,85 @@ def test_regress_rejects_a_bad_suite(tmp_path, capsys):
                                 "tolerances": {}}))
     assert main(["regress", "--baseline", str(path), *FAKE_OPTION]) == 2
     assert "suite entry 'x'" in capsys.readouterr().err
+
+
+def test_compare_uses_each_engines_tolerances_and_says_whether_its_version_changed():
+    baseline = {"tolerances": {"reference": {"default": {"abs": 0.0, "rel": 1e-6}},
+                               "mujoco": {"default": {"abs": 0.0, "rel": 1e-2}}},
+                "results": {
+                    "reference pendulum": {"status": "ok", "expectations_passed": 1,
+                                           "engine_version": "clearbench 0.1.0",
+                                           "metrics": {"x": 1.0}},
+                    "mujoco[tuned] pendulum": {"status": "ok", "expectations_passed": 1,
+                                               "engine_version": "mujoco 4.0.0",
+                                               "metrics": {"x": 1.0, "y": 1.0}},
+                    "pybullet[tuned] pendulum": {"status": "ok", "metrics": {}}}}
+    results = {"reference pendulum": {"status": "ok", "expectations_passed": 1, "message": "",
+                                      "engine": "reference[default]",
+                                      "engine_version": "clearbench 0.1.0",
+                                      "metrics": {"x": 1.0 + 1e-5}},
+               "mujoco[tuned] pendulum": {"status": "ok", "expectations_passed": 1,
+                                          "message": "", "engine": "mujoco[tuned]",
+                                          "engine_version": "mujoco 4.1.0",
+                                          "metrics": {"x": 1.0 + 1e-3, "y": 1.5}}}
+    outcome = compare(baseline, results, {"pybullet[tuned] pendulum": "pybullet not available"})
+    # 1e-5 relative: outside the reference's 1e-6, inside MuJoCo's 1e-2 (x); y moved 50 %.
+    assert outcome.regressions == [
+        "reference pendulum: x 1 -> 1.00001 (tolerance 0 + 1e-06 x |base|) "
+        "[engine clearbench 0.1.0 unchanged]",
+        "mujoco[tuned] pendulum: y 1 -> 1.5 (tolerance 0 + 0.01 x |base|) "
+        "[engine version changed: mujoco 4.0.0 -> mujoco 4.1.0]"]
+    assert "pybullet[tuned] pendulum: not run (pybullet not available)" in outcome.notes
+
+
+def test_regress_covers_one_quick_scene_per_available_engine(tmp_path):
+    """Every available engine on a quick scene: the baseline written from a run passes, and a
+    moved figure is a regression naming the engine, the scene, the figure and the version."""
+    import copy
+
+    from clearbench.adapters import all_availability
+    from clearbench.harness.studies.regress import (
+        DEFAULT_TOLERANCES,
+        ENGINE_PRESETS,
+        run_suite,
+        suite_specs,
+        updated_baseline,
+    )
+
+    suite = [{"id": f"{name}[{ENGINE_PRESETS.get(name, 'default')}] incline-stick",
+              "scene": "incline-stick", "engine": f"{name}[{ENGINE_PRESETS.get(name, 'default')}]",
+              "horizon": 0.05} for name in ENGINE_PRESETS | {"reference": "default"}]
+    baseline = {"suite": suite, "tolerances": DEFAULT_TOLERANCES, "results": {}}
+    skipped: dict = {}
+    results = run_suite(suite_specs(baseline, skipped=skipped))
+    available = {a.engine for a in all_availability() if a.available}
+    assert {r["engine"].split("[")[0] for r in results.values()} == available
+    assert len(skipped) == len(suite) - len(available)
+    written = updated_baseline(baseline, results, skipped)
+    assert compare(written, results, skipped).regressions == []
+    for ident, result in results.items():
+        assert written["results"][ident]["engine_version"] == result["engine_version"] != ""
+    ident = next(iter(results))
+    moved = copy.deepcopy(written)
+    moved["results"][ident]["metrics"]["penetration_max"] = 1.0   # 1 m: far outside
+    moved["results"][ident]["engine_version"] = "older"
+    lines = compare(moved, results, skipped).regressions
+    assert len(lines) == 1 and lines[0].startswith(f"{ident}: penetration_max 1 -> ")
+    assert lines[0].endswith(f"[engine version changed: older -> "
+                             f"{results[ident]['engine_version']}]")
+
+
+def test_a_run_that_timed_out_is_one_status_line_without_a_version():
+    baseline = {"tolerances": {"default": {"abs": 0.0, "rel": 1e-6}},
+                "results": {"siconos[default] pendulum": {
+                    "status": "ok", "expectations_passed": 1, "engine_version": "siconos 4.4",
+                    "metrics": {"x": 1.0, "y": 2.0}}}}
+    results = {"siconos[default] pendulum": {
+        "status": "timed_out", "expectations_passed": None, "engine": "siconos[default]",
+        "engine_version": "", "message": "wall-clock limit of 300 s reached", "metrics": {}}}
+    lines = compare(baseline, results).regressions
+    assert lines == [
+        "siconos[default] pendulum: status ok -> timed_out (wall-clock limit of 300 s reached) "
+        "[engine siconos 4.4 in the baseline; this run reported no version]",
+        "siconos[default] pendulum: expectations passed 1 -> None "
+        "[engine siconos 4.4 in the baseline; this run reported no version]"]

@@ -3,6 +3,9 @@
 - ``clearbench c60 validate``: the validation table against the published figures. Runs the
   C-60 scenes it needs with the reference engine (cached per scene content in ``--cache``),
   prints the table and writes it as Markdown with force-displacement figures.
+- ``clearbench c60 compare [--plan demo|full]``: c60-on and c60-trip in every available engine
+  and preset over a ladder of steps (the plans of :mod:`clearbench.harness.studies.c60_comparison`),
+  the cross-engine table and the work-precision summary printed, then the report written.
 - ``clearbench c60 angles TRAJECTORY.npz``: each body's angle about z and the largest body
   speed along a run (a diagnostic, for example of a cached run).
 """
@@ -16,8 +19,20 @@ from pathlib import Path
 from clearbench.adapters.reference import ReferenceEngine
 from clearbench.adapters.trajectory import Trajectory
 from clearbench.harness.c60.angles import body_angles
+from clearbench.harness.c60.cross_engine import collect
 from clearbench.harness.c60.validation import validate, write_figures, write_json, write_markdown
-from clearbench.harness.cli.common import UserError
+from clearbench.harness.c60.work_precision import steps_for_target, work_precision
+from clearbench.harness.cli.common import (
+    UserError,
+    add_runner_options,
+    engine_modules,
+    make_runner,
+    open_store,
+)
+from clearbench.harness.measure.headline import format_value
+from clearbench.harness.report.page import write_report
+from clearbench.harness.run.engine_choice import RunInputError
+from clearbench.harness.studies.c60_comparison import PLANS, plan_engines, plan_runs
 
 DEFAULT_REPORT = Path("reports/c60_validation.md")
 DEFAULT_FIGURES = Path("reports/figures")
@@ -53,6 +68,24 @@ def register(subparsers) -> None:
     validate.add_argument("--no-sensitivity", action="store_true",
                           help="skip the sensitivity runs (design arm, alternative preload)")
     validate.set_defaults(handler=run_validate)
+    compare = commands.add_parser(
+        "compare", help="c60-on and c60-trip across engines, work-precision, report",
+        description="Run c60-on and c60-trip in every available engine and preset of the "
+        "plan over its ladder of steps (runs already in the store are reused), print the "
+        "cross-engine figures (FC-1, latch creep, trip times, penetration, wall time) and the "
+        "step each engine needs for 1 % on FC-1, and write the report. Plan `demo` (what "
+        "`clearbench demo` runs: shortened horizons, a few minutes of CPU) or `full` (the "
+        "scenes' horizons and longer ladders: hours).",
+    )
+    compare.add_argument("--plan", choices=sorted(PLANS), default="demo",
+                         help="which runs (default demo)")
+    compare.add_argument("--engines", "-e", nargs="+", default=None, metavar="ENGINE[PRESET]",
+                         help="only these labels of the plan (default: every label whose "
+                         "engine is available)")
+    compare.add_argument("--out", default="reports/out", metavar="DIR",
+                         help="report directory (default reports/out)")
+    add_runner_options(compare, timeout=7200.0)
+    compare.set_defaults(handler=run_c60_compare)
     angles = commands.add_parser(
         "angles", help="each body's angle about z and the largest speed along a trajectory",
         description="For a trajectory written by the reference engine (for example the cache "
@@ -102,4 +135,52 @@ def run_angles(args: argparse.Namespace) -> int:
     for sample in body_angles(trajectory, args.every):
         print(f"{sample.time:6.2f}  " + "  ".join(f"{a:12.3f}" for a in sample.angles)
               + f"  {sample.max_speed:9.3g}")
+    return 0
+
+
+def run_c60_plan(plan_name: str, labels, modules, args, store) -> set[str]:
+    """Validate and run the plan's C-60 runs (``labels``: only these engine labels); print
+    the labels left out and why, then the cross-engine figures. Returns the run keys."""
+    plan = PLANS[plan_name]
+    try:
+        engines, left_out = plan_engines(plan, labels, modules)
+        specs = plan_runs(plan, engines)
+    except RunInputError as error:
+        raise UserError(str(error)) from None
+    for label, reason in left_out.items():
+        print(f"C-60 {plan.name}: {label} left out: {reason}")
+    print(f"C-60 {plan.name} ({plan.description}): {len(specs)} runs")
+    runner = make_runner(args, store, len(specs))
+    outcome = runner.run_all(specs)
+    print(f"C-60: {len(outcome.ran)} runs done, {len(outcome.skipped)} reused from the store")
+    print_c60(store, {s.key for s in specs})
+    return {s.key for s in specs}
+
+
+def print_c60(store, keys: set[str]) -> None:
+    """The cross-engine figures of the runs ``keys`` and the step each engine needs for 1 %
+    on FC-1."""
+    frame = store.dataframe(expand_metrics=False)
+    runs = collect(store, frame[frame["key"].isin(keys)])
+    print(f"\n  {'scene':<9} {'engine':<20} {'dt [ms]':>8} {'status':<10} {'FC-1 [N]':>9} "
+          f"{'creep [mm]':>10} {'open [ms]':>9} {'pen. [mm]':>9} {'wall [s]':>8} {'x ref':>6}")
+    for run in runs:
+        print(f"  {run.scene_name:<9} {run.label:<20} {run.time_step:>8.3g} {run.status:<10} "
+              f"{format_value(run.fc1):>9} {format_value(run.latch_creep):>10} "
+              f"{format_value(run.opening):>9} {format_value(run.penetration_max):>9} "
+              f"{format_value(run.stepping_seconds):>8} "
+              f"{format_value(run.ratio_to_reference):>6}")
+    for study in work_precision(runs):
+        print(f"\n  {study.quantity}: reference {study.reference_value:.5g} at dt = "
+              f"{study.reference_step:g} ms (horizon {study.horizon:g} ms); error <= 1 %:")
+        for entry in steps_for_target(study):
+            print(f"    {entry.label:<22} {entry.describe()}")
+
+
+def run_c60_compare(args: argparse.Namespace) -> int:
+    modules = engine_modules(args)
+    store = open_store(args)
+    run_c60_plan(args.plan, args.engines, modules, args, store)
+    paths = write_report(store, args.out)
+    print(f"\nreport: {paths['html']}\nsummary: {paths['markdown']}")
     return 0

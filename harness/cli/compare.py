@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import time
 
+from clearbench.harness.cli.c60 import run_c60_plan
 from clearbench.harness.cli.common import (
     UserError,
     add_runner_options,
@@ -15,6 +16,7 @@ from clearbench.harness.cli.common import (
 from clearbench.harness.cli.sweep import print_work_precision
 from clearbench.harness.report.page import write_report
 from clearbench.harness.run.engine_choice import RunInputError, resolve_engine
+from clearbench.harness.studies.c60_comparison import PLANS
 from clearbench.harness.studies.stability import available_engines, plan_stability
 from clearbench.harness.studies.sweep import (
     FINE_FACTOR,
@@ -63,6 +65,9 @@ def add_compare_options(parser: argparse.ArgumentParser) -> None:
                         help=f"time-step ladder (default {COMPARE_LADDER})")
     parser.add_argument("--stability", action="store_true",
                         help="also run the stiff and extreme suite")
+    parser.add_argument("--c60", choices=("none", *sorted(PLANS)), default="demo",
+                        help="C-60 runs across engines after the scenes: the `demo` plan "
+                        "(default; shortened horizons, a few minutes), `full` (hours) or none")
     parser.add_argument("--out", default="reports/out", metavar="DIR",
                         help="report directory (default reports/out)")
     add_runner_options(parser, timeout=300.0)
@@ -98,6 +103,10 @@ def run_compare(args: argparse.Namespace) -> int:
           f"{time.monotonic() - start:.0f} s")
     print_work_precision(store, [s.scene.name for s in plan.all_specs],
                          {s.key for s in plan.all_specs})
+    if args.c60 != "none":
+        print()
+        run_c60_plan(args.c60, [e.label for e in engines] if args.engines else None, modules,
+                     args, store)
     paths = write_report(store, args.out)
     print(f"\nreport: {paths['html']}\nsummary: {paths['markdown']} "
           f"({time.monotonic() - start:.0f} s in all)")

@@ -2,6 +2,8 @@
 
 - :func:`work_precision_figure`: error against stepping time per simulated time unit, one line
   per engine over its ladder of steps, the Pareto front circled;
+- :func:`c60_work_precision_figure`: the C-60's FC-1 and opening-time errors against wall
+  time per run, one panel each, the same lines and front;
 - :func:`time_series_figure`: drift and creep over time (penetration, clearance excess, joint
   gap, slip of bodies that must stick, energy change), one line per engine.
 """
@@ -17,6 +19,7 @@ import numpy as np
 from clearbench.adapters.trajectory import Trajectory
 from clearbench.harness.measure import series as metrics
 from clearbench.harness.measure.figures import STICK_KINDS
+from clearbench.harness.report.engine_style import engine_style
 from clearbench.scenarios.scene import Scene
 
 LOG = logging.getLogger(__name__)
@@ -42,6 +45,23 @@ def _png(figure) -> bytes:
     return buffer.getvalue()
 
 
+def ladder_line(axes, label: str, x, y, steps) -> None:
+    """One engine's ladder on log-log axes in its own style, each point annotated with its
+    step. ``x``, ``y``, ``steps``: (n,) sequences."""
+    style = engine_style(label)
+    axes.loglog(x, y, label=label, **style.plot_kwargs())
+    for xi, yi, dt in zip(x, y, steps, strict=True):
+        axes.annotate(f"{dt:.2g}", (xi, yi), textcoords="offset points", xytext=(4, 3),
+                      fontsize=7, color=style.colour)
+
+
+def pareto_circles(axes, x, y) -> None:
+    """Circle the Pareto-front points (x, y: (n,) sequences) in black."""
+    if len(x):
+        axes.loglog(x, y, "o", markersize=12, markerfacecolor="none",
+                    markeredgecolor="black", label="Pareto front")
+
+
 def work_precision_figure(points, title: str) -> bytes:
     """``points``: DataFrame from :func:`.sweep.work_precision_points`."""
     plt = _pyplot()
@@ -52,15 +72,9 @@ def work_precision_figure(points, title: str) -> bytes:
         rows = rows.sort_values("stepping_seconds_per_simulated_second")
         x = rows["stepping_seconds_per_simulated_second"].to_numpy(dtype=float)
         y = rows["error"].to_numpy(dtype=float)
-        (line,) = axes.loglog(x, y, "o-", label=label)
-        for xi, yi, dt in zip(x, y, rows["time_step"], strict=True):
-            axes.annotate(f"{dt:.2g}", (xi, yi), textcoords="offset points", xytext=(4, 3),
-                          fontsize=7, color=line.get_color())
+        ladder_line(axes, label, x, y, rows["time_step"])
     front = points[points["pareto"].astype(bool)]
-    if len(front):
-        axes.loglog(front["stepping_seconds_per_simulated_second"], front["error"], "o",
-                    markersize=12, markerfacecolor="none", markeredgecolor="black",
-                    label="Pareto front")
+    pareto_circles(axes, front["stepping_seconds_per_simulated_second"], front["error"])
     if len(exact):
         axes.text(0.02, 0.02, "error 0 (not drawn): " + ", ".join(
             f"{label} dt={dt:.2g}" for label, dt in zip(exact["label"], exact["time_step"],
@@ -71,6 +85,34 @@ def work_precision_figure(points, title: str) -> bytes:
     axes.set_title(title, fontsize=10)
     axes.grid(True, which="both", alpha=0.3)
     axes.legend(fontsize=8)
+    return _png(figure)
+
+
+def c60_work_precision_figure(studies) -> bytes | None:
+    """``studies``: :class:`~clearbench.harness.c60.work_precision.WorkPrecision` list, one
+    panel each (relative error against stepping wall time per run [s]); None when no study
+    has a point with a non-zero error."""
+    drawn = [s for s in studies if any(p.error > 0 for p in s.points)]
+    if not drawn:
+        return None
+    plt = _pyplot()
+    figure, axes_row = plt.subplots(1, len(drawn), figsize=(5.2 * len(drawn), 4.2),
+                                    squeeze=False)
+    for axes, study in zip(axes_row[0], drawn, strict=True):
+        points = [p for p in study.points if p.error > 0]
+        for label in sorted({p.label for p in points}):
+            mine = sorted((p for p in points if p.label == label), key=lambda p: p.wall_seconds)
+            ladder_line(axes, label, [p.wall_seconds for p in mine], [p.error for p in mine],
+                        [p.time_step for p in mine])
+        front = [p for p in points if p.on_front]
+        pareto_circles(axes, [p.wall_seconds for p in front], [p.error for p in front])
+        axes.axhline(0.01, color="grey", linewidth=0.8, linestyle=":")
+        axes.set_xlabel("stepping wall time per run [s]")
+        axes.set_ylabel(f"{study.quantity}: relative error")
+        axes.set_title(f"{study.scene_name} ({study.horizon:g} ms): {study.quantity} against "
+                       f"the reference at dt {study.reference_step:g} ms", fontsize=9)
+        axes.grid(True, which="both", alpha=0.3)
+        axes.legend(fontsize=7)
     return _png(figure)
 
 
@@ -127,7 +169,9 @@ def time_series_figure(scene: Scene, runs: dict[str, Trajectory]) -> bytes | Non
                                 sharex=True, squeeze=False)
     for axis, title in zip(axes[:, 0], panels, strict=True):
         for label, (t, values) in data[title].items():
-            axis.plot(t, values, label=label, linewidth=1.0)
+            style = engine_style(label)
+            axis.plot(t, values, label=label, linewidth=1.0, color=style.colour,
+                      linestyle=style.line_style)
         axis.set_ylabel(title, fontsize=8)
         axis.grid(True, alpha=0.3)
         axis.ticklabel_format(axis="y", style="sci", scilimits=(-3, 3))

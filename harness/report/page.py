@@ -1,12 +1,14 @@
 """The comparison report: a self-contained HTML page and a Markdown summary from a results store.
 
-Contents: an overview matrix (scene x engine: verdict and headline metric), the stiff and
-extreme suite in the same form, per scene a table of every run with its metrics, the
+Contents, the tables a reader looks at first: an overview matrix (scene x engine: verdict and
+headline metric), the stiff and extreme suite in the same form, the C-60 across engines
+(:mod:`.c60_section`: c60-on and c60-trip per engine, work-precision) and, when ``clearbench
+c60 validate`` has written its JSON, the C-60 table against the paper and its
+force-displacement figures; then the detail: per scene a table of every run with its metrics, the
 work–precision plot with its Pareto front and drift and creep over time, and per engine the
 features it approximates or does not support (from ``Engine.capabilities``, recorded with each
-run); when ``clearbench c60 validate`` has written its JSON, the C-60 table against the paper
-and its force-displacement figures. Figures are embedded as base64 PNG in the HTML and written
-as PNG files beside the Markdown.
+run; each once per engine and feature, the detail folded). Figures are embedded as base64 PNG
+in the HTML and written as PNG files beside the Markdown.
 """
 
 from __future__ import annotations
@@ -28,6 +30,9 @@ from clearbench.harness.measure.headline import (
     headline,
     scene_metric_names,
 )
+from clearbench.harness.report.c60_section import C60Section, build_section
+from clearbench.harness.report.c60_section import section_html as c60_engines_html
+from clearbench.harness.report.c60_section import section_markdown as c60_engines_markdown
 from clearbench.harness.report.figures import time_series_figure, work_precision_figure
 from clearbench.harness.run.store import ResultsStore
 from clearbench.harness.studies.campaign.report import load_written_sections
@@ -66,6 +71,8 @@ class ReportData:
     c60_validation: dict | None = None   # clearbench c60 validate's JSON (see load_c60_validation)
     #: tolerance campaigns written by ``clearbench campaign report`` (summary, figures)
     campaigns: list = field(default_factory=list)
+    #: the C-60 across engines (c60-on and c60-trip runs of the store)
+    c60_engines: C60Section | None = None
 
 
 def _representative(rows, scene: Scene | None) -> dict:
@@ -105,7 +112,8 @@ def collect(store: ResultsStore, figures: bool = True) -> ReportData:
     sections.sort(key=lambda s: (s.scene is not None and "stiff" in s.scene.tags, s.name))
     return ReportData(frame, sections, sorted(frame["label"].unique()) if len(frame) else [],
                       approximations, str(store.directory),
-                      datetime.now(UTC).isoformat(timespec="seconds"))
+                      datetime.now(UTC).isoformat(timespec="seconds"),
+                      c60_engines=build_section(store, frame, figures) if len(frame) else None)
 
 
 def _figures(store: ResultsStore, section: SceneSection) -> None:
@@ -158,11 +166,31 @@ def _metric_columns(section: SceneSection) -> list[str]:
 
 
 def _engine_notes(data: ReportData) -> list[tuple[str, str, str, str]]:
-    rows = []
+    """(engines, feature, support, how): each approximation once per engine and feature, the
+    presets that state it in the same words listed together (``mujoco[default, tuned]``)."""
+    grouped: dict[tuple[str, str, str, str], list[str]] = {}
     for label in data.engines:
+        name, _, preset = label.partition("[")
         for feature, (kind, detail) in sorted(data.approximations.get(label, {}).items()):
-            rows.append((label, feature, kind, detail))
-    return rows
+            grouped.setdefault((name, feature, kind, detail), []).append(preset.rstrip("]"))
+    return [(f"{name}[{', '.join(presets)}]", feature, kind, detail)
+            for (name, feature, kind, detail), presets in sorted(grouped.items())]
+
+
+#: The first this many characters of an approximation's detail are shown, the rest folded.
+DETAIL_SUMMARY = 160
+
+
+def _folded(detail: str) -> str:
+    """HTML of a long detail: its first sentence (at most DETAIL_SUMMARY characters) shown,
+    the whole text folded in a <details>."""
+    text = str(detail)
+    first = text.split(". ", 1)[0]
+    if len(first) > DETAIL_SUMMARY:
+        first = first[:DETAIL_SUMMARY].rsplit(" ", 1)[0] + " ..."
+    if first == text:
+        return _esc(text)
+    return f"<details><summary>{_esc(first)}</summary>{_esc(text)}</details>"
 
 
 # ---------------------------------------------------------------------------- HTML
@@ -249,6 +277,17 @@ def _messages_html(section: SceneSection) -> str:
     return f"<ul>{''.join(items)}</ul>" if items else ""
 
 
+#: One line under each per-scene figure: what it shows and what to look for.
+FIGURE_CAPTIONS = {
+    "Work–precision": "Error against stepping time per simulated unit over each engine's "
+                      "ladder of steps (labels: steps), circles the Pareto front: look for the "
+                      "lowest line furthest left.",
+    "Drift and creep over time": "Penetration, clearance excess, joint gap, slip of a body "
+                                 "that must stick and energy change along each engine's run "
+                                 "at the scene's step: look for growth and jumps.",
+}
+
+
 def _section_html(section: SceneSection) -> str:
     scene = section.scene
     intro = _esc(scene.description) if scene is not None else ""
@@ -257,7 +296,8 @@ def _section_html(section: SceneSection) -> str:
     figures = "".join(
         f"<figure><img alt='{_esc(title)} of {_esc(section.name)}' "
         f"src='data:image/png;base64,{base64.b64encode(png).decode()}'>"
-        f"<figcaption class='small'>{_esc(title)}</figcaption></figure>"
+        f"<figcaption class='small'><b>{_esc(title)}.</b> "
+        f"{_esc(FIGURE_CAPTIONS.get(title, ''))}</figcaption></figure>"
         for title, png in section.figures.items())
     notes = "".join(f"<p class='small'>{_esc(n)}</p>" for n in section.notes)
     return (f"<h2 id='scene-{_esc(section.name)}'>{_esc(section.name)}</h2><p>{intro}{units}</p>"
@@ -267,7 +307,7 @@ def _section_html(section: SceneSection) -> str:
 
 def _engines_html(data: ReportData) -> str:
     rows = "".join(f"<tr><td>{_esc(a)}</td><td>{_esc(b)}</td><td>{_esc(c)}</td>"
-                   f"<td>{_esc(d)}</td></tr>" for a, b, c, d in _engine_notes(data))
+                   f"<td>{_folded(d)}</td></tr>" for a, b, c, d in _engine_notes(data))
     versions = data.frame.groupby("label")["engine_version"].last() if len(data.frame) else {}
     version_rows = "".join(f"<tr><td>{_esc(k)}</td><td>{_esc(v)}</td></tr>"
                            for k, v in dict(versions).items())
@@ -369,8 +409,9 @@ def render_html(data: ReportData) -> str:
         "stepping alone.</p>",
         _overview_html(data, stiff=False),
         _overview_html(data, stiff=True),
-        *(_section_html(s) for s in data.sections),
+        c60_engines_html(data.c60_engines) if data.c60_engines else "",
         _c60_html(data.c60_validation) if data.c60_validation else "",
+        *(_section_html(s) for s in data.sections),
         *(campaign_section_html(summary, pngs) for summary, pngs in data.campaigns),
         _engines_html(data),
     ]
@@ -385,8 +426,8 @@ def _md_escape(text) -> str:
     return str(text).replace("|", "\\|").replace("\n", " ")
 
 
-def render_markdown(data: ReportData, figure_files: dict, c60_figure_files: dict | None = None
-                    ) -> str:
+def render_markdown(data: ReportData, figure_files: dict, c60_figure_files: dict | None = None,
+                    c60_engines_figure: str | None = None) -> str:
     lines = ["# clearbench comparison report", "",
              f"Generated {data.generated} from `{data.store}`: {len(data.frame)} runs. "
              "Full report with figures: `report.html`.", ""]
@@ -405,6 +446,10 @@ def render_markdown(data: ReportData, figure_files: dict, c60_figure_files: dict
                 cells.append(_md_escape(f"**{status}** {text}".strip() if status else text))
             lines.append(f"| {section.name} | " + " | ".join(cells) + " |")
         lines.append("")
+    if data.c60_engines:
+        lines += c60_engines_markdown(data.c60_engines, c60_engines_figure)
+    if data.c60_validation:
+        lines += _c60_markdown(data.c60_validation, c60_figure_files or {})
     for section in data.sections:
         columns = _metric_columns(section)
         lines += [f"### {section.name}", "",
@@ -418,10 +463,8 @@ def render_markdown(data: ReportData, figure_files: dict, c60_figure_files: dict
                          + " | ".join(format_value(figures.get(c)) for c in columns)
                          + f" | {format_value(run['stepping_seconds_per_step'], 's')} |")
         for title, path in figure_files.get(section.name, {}).items():
-            lines += ["", f"![{title}]({path})"]
+            lines += ["", f"![{title}]({path})", "", f"*{FIGURE_CAPTIONS.get(title, title)}*"]
         lines.append("")
-    if data.c60_validation:
-        lines += _c60_markdown(data.c60_validation, c60_figure_files or {})
     for summary, pngs in data.campaigns:
         lines += ["", campaign_section_markdown(summary, list(pngs))]
     notes = _engine_notes(data)
@@ -463,6 +506,10 @@ def write_report(store: ResultsStore, out_dir: str | Path,
             name = f"figures/c60-validation-{index}.png"
             (out / name).write_bytes(png)
             c60_figure_files[title] = name
+    c60_engines_figure = None
+    if data.c60_engines is not None and data.c60_engines.figure is not None:
+        c60_engines_figure = "figures/c60-work-precision.png"
+        (out / c60_engines_figure).write_bytes(data.c60_engines.figure)
     figure_files: dict[str, dict[str, str]] = {}
     for section in data.sections:
         for index, (title, png) in enumerate(section.figures.items()):
@@ -472,5 +519,6 @@ def write_report(store: ResultsStore, out_dir: str | Path,
     html_path = out / "report.html"
     md_path = out / "summary.md"
     html_path.write_text(render_html(data), encoding="utf-8")
-    md_path.write_text(render_markdown(data, figure_files, c60_figure_files), encoding="utf-8")
+    md_path.write_text(render_markdown(data, figure_files, c60_figure_files, c60_engines_figure),
+                       encoding="utf-8")
     return {"html": html_path, "markdown": md_path}

@@ -1,0 +1,120 @@
+"""The C-60 across engines: which runs of ``c60-on`` and ``c60-trip`` each engine and preset
+makes (a ladder of time steps per engine, for the work-precision study), in two plans:
+
+- ``demo``: what ``clearbench demo`` runs, budgeted to a few minutes of CPU on a 2-core
+  machine: horizons shortened to 4 ms (c60-on: the mechanism is settled from 3 ms and FC-1 is
+  the mean over the last 1 ms) and 8.5 ms (c60-trip: the reference's contacts open at 7.6 ms),
+  short ladders, the expensive engines at one step;
+- ``full``: the scenes' own horizons (7 ms, 20 ms) and longer ladders for every preset (hours
+  of CPU; ``clearbench c60 compare --plan full``).
+
+Steps and horizons in ms (the scenes' mm-g-ms units). Timeouts are wall-clock limits against
+hangs, generous because the machine may be shared (a c60-trip of the reference that takes
+58 s of CPU timed out at 600 s under a load of 15 on 2 cores). An engine not available here
+is left out of the runs (the report lists it with the reason); a preset that cannot build the
+C-60 records an ``unsupported`` run with its reason.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+from clearbench.harness.c60.cross_engine import ON_SCENE, TRIP_SCENE
+from clearbench.harness.run.engine_choice import EngineChoice, RunInputError, resolve_engine
+from clearbench.harness.run.spec import RunSpec, make_run_spec
+
+#: Samples are recorded about every SAMPLE_SPACING ms whatever the step: trip events are
+#: resolved to 0.01 ms (the events are 0.8-4 ms apart) and FC-1's 1 ms window averages 100
+#: samples.
+SAMPLE_SPACING = 0.01
+
+
+@dataclass(frozen=True)
+class C60Plan:
+    """``horizons``: scene -> horizon [ms]; ``ladders``: scene -> engine label -> steps [ms]."""
+
+    name: str
+    description: str
+    horizons: Mapping[str, float]
+    ladders: Mapping[str, Mapping[str, tuple[float, ...]]]
+    timeout: float
+
+    def labels(self) -> list[str]:
+        return list(dict.fromkeys(label for ladder in self.ladders.values() for label in ladder))
+
+
+DEMO = C60Plan(
+    "demo",
+    "c60-on to 4 ms and c60-trip to 8.5 ms (shortened for the demo); the reference at 1 us "
+    "is the fine run every error is measured against",
+    {ON_SCENE: 4.0, TRIP_SCENE: 8.5},
+    {ON_SCENE: {"reference[default]": (1e-3, 4e-3),
+                "mujoco[default]": (1e-3,),
+                "mujoco[tuned]": (1e-3, 2e-3, 4e-3, 8e-3),
+                "pybullet[tuned]": (2e-3, 4e-3),
+                "siconos[default]": (1e-2,),
+                "siconos[projection]": (1e-2,),
+                "exudyn[tuned]": (1e-3,)},
+     TRIP_SCENE: {"reference[default]": (1e-3,),
+                  "mujoco[tuned]": (1e-3, 4e-3)}},
+    timeout=1800.0)
+
+FULL = C60Plan(
+    "full",
+    "c60-on (7 ms) and c60-trip (20 ms) at the scenes' own horizons; the reference at 0.5 us "
+    "is the fine run every error is measured against",
+    {ON_SCENE: 7.0, TRIP_SCENE: 20.0},
+    {scene: {"reference[default]": (5e-4, 1e-3, 2e-3, 4e-3),
+             "mujoco[default]": (1e-3, 4e-3),
+             "mujoco[tuned]": (1e-3, 2e-3, 4e-3, 8e-3),
+             "pybullet[default]": (1e-3,),
+             "pybullet[tuned]": (1e-3, 2e-3, 4e-3),
+             "siconos[default]": (1e-3, 2e-3, 1e-2),
+             "siconos[nsn-ac]": (1e-3,),
+             "siconos[projection]": (1e-3,),
+             "exudyn[default]": (1e-3,),
+             "exudyn[tuned]": (1e-3,)} for scene in (ON_SCENE, TRIP_SCENE)},
+    timeout=7200.0)
+
+PLANS = {plan.name: plan for plan in (DEMO, FULL)}
+
+
+def record_every(time_step: float) -> int:
+    """Steps between recorded samples for about :data:`SAMPLE_SPACING` ms."""
+    return max(1, round(SAMPLE_SPACING / time_step))
+
+
+def plan_runs(plan: C60Plan, engines: Sequence[EngineChoice],
+              campaign: str = "c60-compare") -> list[RunSpec]:
+    """The plan's runs for the engines given (EngineChoice of each available label); labels
+    of the plan whose engine is not among them are left out. The reference runs come first:
+    they are the fine runs the others are measured against."""
+    chosen = {engine.label: engine for engine in engines}
+    specs = []
+    for scene_name, ladder in plan.ladders.items():
+        for label, steps in ladder.items():
+            engine = chosen.get(label)
+            if engine is None:
+                continue
+            for dt in steps:
+                specs.append(make_run_spec(
+                    scene_name, label, scene_parameters={"horizon": plan.horizons[scene_name]},
+                    time_step=dt, record_every=record_every(dt), timeout=plan.timeout,
+                    engine_choice=engine, campaign=f"{campaign}:{plan.name}"))
+    specs.sort(key=lambda s: s.engine.name != "reference")
+    return specs
+
+
+def plan_engines(plan: C60Plan, labels: Sequence[str] | None = None,
+                 extra_modules: Mapping[str, str] | None = None
+                 ) -> tuple[list[EngineChoice], dict[str, str]]:
+    """The plan's engine labels (or ``labels``) resolved, and label -> why not, for those
+    that cannot run here (engine not available, preset refused)."""
+    chosen, left_out = [], {}
+    for label in labels if labels is not None else plan.labels():
+        try:
+            chosen.append(resolve_engine(label, extra_modules))
+        except RunInputError as error:
+            left_out[label] = error.reason
+    return chosen, left_out
