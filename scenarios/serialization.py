@@ -127,7 +127,11 @@ def scene_from_dict(data: Any) -> Scene:
 
 
 def scene_from_json(text: str) -> Scene:
-    return scene_from_dict(json.loads(text))
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as error:
+        raise SceneError("file", "JSON text", f"not valid JSON: {error}") from None
+    return scene_from_dict(data)
 
 
 def scene_from_toml(text: str) -> Scene:
@@ -141,10 +145,35 @@ def scene_from_toml(text: str) -> Scene:
     return scene_from_dict(data)
 
 
-def load_scene_file(path: str | Path) -> Scene:
-    """Read a scene from a ``.toml`` or ``.json`` file."""
+def read_scene_text(path: str | Path) -> str:
+    """The text of a scene file, strictly UTF-8.
+
+    Raises :class:`SceneError` naming the file when it holds a NUL byte (a binary file) or a
+    byte sequence that is not UTF-8, or cannot be read (a directory, no permission);
+    :class:`FileNotFoundError` when it does not exist."""
     path = Path(path)
-    text = path.read_text()
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise
+    except OSError as error:
+        raise SceneError("file", str(path), f"cannot be read: {error.strerror or error}") \
+            from None
+    nul = data.find(b"\0")
+    if nul >= 0:
+        raise SceneError("file", str(path), f"is a binary file (NUL byte at offset {nul}), "
+                         "not a TOML or JSON scene")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        raise SceneError("file", str(path), f"is not UTF-8 text (byte "
+                         f"0x{data[error.start]:02x} at offset {error.start})") from None
+
+
+def load_scene_file(path: str | Path) -> Scene:
+    """Read a scene from a ``.toml`` or ``.json`` file (UTF-8, :func:`read_scene_text`)."""
+    path = Path(path)
+    text = read_scene_text(path)
     if path.suffix == ".json":
         return scene_from_json(text)
     return scene_from_toml(text)

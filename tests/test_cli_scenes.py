@@ -92,3 +92,46 @@ def test_every_command_has_help(capsys):
             main([command, "--help"])
         assert caught.value.code == 0
         assert "usage" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("content", "expected"),
+    [
+        (b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR", "is a binary file (NUL byte at offset 8)"),
+        ('name = "caf\u00e9"\n'.encode("latin-1"), "is not UTF-8 text (byte 0xe9 at offset 11)"),
+    ],
+    ids=["binary", "latin-1"],
+)
+def test_a_file_that_is_not_utf8_text_exits_2_naming_file_and_problem(tmp_path, capsys,
+                                                                      content, expected):
+    path = tmp_path / "scene.toml"
+    path.write_bytes(content)
+    assert main(["validate", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert str(path) in err and expected in err and "Traceback" not in err
+    # The run command reads scene files the same way, before any engine runs.
+    assert main(["run", str(path), "-e", "reference", "--store", str(tmp_path / "s")]) == 2
+    err = capsys.readouterr().err
+    assert str(path) in err and expected in err
+
+
+@pytest.mark.parametrize("radius", ["1e308", "1e31", "-1e31"])
+def test_a_magnitude_that_would_overflow_the_engines_is_refused_naming_the_field(
+        tmp_path, capsys, radius):
+    text = EXAMPLE.read_text()
+    assert "radius = 5.0" in text
+    path = tmp_path / "huge.toml"
+    path.write_text(text.replace("radius = 5.0", f"radius = {radius}", 1))
+    assert main(["validate", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert "radius" in err and "magnitude exceeds 1e+30" in err
+
+
+def test_the_magnitude_bound_lets_every_library_scene_through():
+    # MAX_MAGNITUDE must refuse nothing a real mechanism needs: every registered scene, also
+    # rescaled to the smallest units offered (um, mg, us: lengths x 1e6), validates.
+    from clearbench.scenarios.library import get_entry
+    from clearbench.scenarios.units import UnitSystem
+
+    for name in scene_names():
+        get_entry(name).build().rescaled(UnitSystem("um", "mg", "us"))

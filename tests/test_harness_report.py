@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import base64
+import html
+import json
 import re
 import shutil
 import subprocess
@@ -12,16 +14,32 @@ import pandas as pd
 import pytest
 
 from clearbench.harness.cli.main import main
+from clearbench.harness.measure.verdicts import VERDICTS
 from clearbench.harness.report.figures import work_precision_figure
 from clearbench.harness.report.page import write_report
 from clearbench.harness.run.runner import Runner
 from clearbench.harness.run.spec import make_run_spec
 from clearbench.harness.run.store import ResultsStore
 from clearbench.harness.studies.sweep import pareto_front, work_precision_points
+from clearbench.scenarios.bodies import Body
+from clearbench.scenarios.expectations import Expectation
+from clearbench.scenarios.inertia import solid_sphere
+from clearbench.scenarios.scene import Scene
+from clearbench.scenarios.shapes import Sphere
 
 from .harness_helpers import FAKE, needs_metrics
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def _resting_block() -> Scene:
+    """A ball at rest without gravity that must not move (a ``sticks`` expectation)."""
+    return Scene(name="resting-block", description="A ball at rest, no gravity: it stays.",
+                 gravity=(0.0, 0.0, 0.0), horizon=0.3, time_step=1e-3,
+                 bodies=(Body("ball", mass=1.0, inertia=solid_sphere(1.0, 0.1),
+                              shapes=(Sphere("sphere", radius=0.1),)),),
+                 expectations=(Expectation("still", kind="sticks", body="ball",
+                                          parameters={"start_time": 0.0, "end_time": 0.3}),))
 
 
 @pytest.fixture(scope="module")
@@ -36,6 +54,10 @@ def small_store(tmp_path_factory):
         make_run_spec("pendulum", "fake[segfault]", horizon=0.3, extra_engine_modules=FAKE),
         make_run_spec("clearance-pendulum", "fake", horizon=0.3, extra_engine_modules=FAKE),
         make_run_spec("stiff-spring", "fake", horizon=0.3, extra_engine_modules=FAKE),
+        # Finishes (status ok) but fails its physics: the fake engine's bias moves a body
+        # that must stay still.
+        make_run_spec(_resting_block(), "fake", options={"bias": 0.01},
+                      extra_engine_modules=FAKE),
     ]
     Runner(store, jobs=2).run_all(specs)
     return store
@@ -65,6 +87,55 @@ def test_report_command(small_store, tmp_path, capsys):
     assert (out / "report.html").exists() and (out / "summary.md").exists()
     assert main(["report", "--store", str(tmp_path / "empty"), "--out", str(out)]) == 2
     assert "no results store" in capsys.readouterr().err
+
+
+#: status of a run -> its verdict, for every status but ok.
+NOT_FINISHED = {"diverged": "diverged", "crashed": "crashed", "timed_out": "timed out",
+                "unsupported": "unsupported"}
+
+
+def _expected_verdicts(store) -> dict:
+    """(scene, engine label) -> the verdict the overview must show, from the store alone: the
+    run at the scene's own step; its status, and for a finished run its expectations."""
+    frame = store.dataframe()
+    expected = {(scene, label): "not run" for scene in frame["scene_name"].unique()
+                for label in frame["label"].unique()}
+    for (scene_name, label), runs in frame.groupby(["scene_name", "label"]):
+        step = store.scene(runs.iloc[-1]["scene_hash"]).time_step
+        row = runs.iloc[int(np.argmin(np.abs(np.log(runs["time_step"] / step))))]
+        if row["status"] != "ok":
+            verdict = NOT_FINISHED[row["status"]]
+        else:
+            passed = [r["passed"] for r in json.loads(row["expectations"] or "[]")
+                      if r["passed"] is not None]
+            verdict = "no check" if not passed else "pass" if all(passed) else "physics failed"
+        expected[(scene_name, label)] = verdict
+    return expected
+
+
+MATRIX_CELL = re.compile(r"""<td class=["']verdict["'] data-scene=["']([^"']+)["'] """
+                         r"""data-engine=["']([^"']+)["'] data-verdict=["']([^"']+)["']""")
+
+
+def _matrix_cells(page: str) -> dict:
+    return {(html.unescape(scene), html.unescape(engine)): html.unescape(verdict)
+            for scene, engine, verdict in MATRIX_CELL.findall(page)}
+
+
+def test_overview_matrix_shows_the_verdict_of_status_and_expectations(small_store, tmp_path):
+    paths = write_report(small_store, tmp_path / "out")
+    page = paths["html"].read_text()
+    cells = _matrix_cells(page)
+    expected = _expected_verdicts(small_store)
+    assert cells == expected
+    # The store holds a finished run that failed its physics, and the matrix says so.
+    assert "physics failed" in cells.values(), cells
+    # Colour and symbol both, and a legend naming every verdict.
+    for name, style in VERDICTS.items():
+        assert f"{style.symbol} {name}" in page and style.colour in page
+    summary = paths["markdown"].read_text()
+    for verdict in set(expected.values()) - {"not run"}:
+        assert f"**{VERDICTS[verdict].symbol} {verdict}**" in summary
 
 
 def _chromium() -> str | None:
@@ -98,7 +169,9 @@ def test_report_opens_in_headless_chromium(small_store, tmp_path):
     dom = subprocess.run(flags + ["--dump-dom", paths["html"].as_uri()], capture_output=True,
                          text=True, timeout=120)
     assert dom.returncode == 0
-    assert "<table>" in dom.stdout and "bouncing-ball-e0.5" in dom.stdout
+    assert "<table" in dom.stdout and "bouncing-ball-e0.5" in dom.stdout
+    # The matrix the browser built holds, cell for cell, the verdict the store implies.
+    assert _matrix_cells(dom.stdout) == _expected_verdicts(small_store)
 
 
 def test_pareto_front_keeps_the_non_dominated_points():

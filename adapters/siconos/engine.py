@@ -18,8 +18,9 @@ Presets (each a separate engine variant ``siconos[preset]`` in results):
   (``MoreauJeanCombinedProjectionOSI`` + ``TimeSteppingCombinedProjection``; enumerative MLCP
   projection on the active set, tolerance 1e-8 x the scene's smallest feature length). It
   refuses pairs that drop candidates (bounded faces, bores): see PROJECTION_DROPPED_SLOTS.
-- ``nsn-ac``: as ``default`` with the semismooth Newton (Alart-Curnier) fc3d solver (scenes
-  with ideal joints still use ``GenericMechanical``, whose only solver is NSGS).
+- ``nsn-ac``: as ``default`` with the semismooth Newton (Alart-Curnier) fc3d solver; scenes
+  with ideal joints use ``GenericMechanical``, whose only solver is NSGS over its blocks, with
+  the Alart-Curnier Newton (``ONECONTACT_NSN``) as the local solver of each contact block.
 
 Options (``RunSettings.options``) override: ``theta``, ``projection``, ``solver`` ("nsgs" /
 ``"nsn-ac"``), ``tolerance``, ``max_iterations``, ``newton_iterations``, ``newton_tolerance``,

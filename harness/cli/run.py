@@ -15,6 +15,7 @@ from clearbench.harness.cli.common import (
     open_store,
 )
 from clearbench.harness.measure.headline import format_value
+from clearbench.harness.measure.verdicts import run_verdict, verdict_text
 from clearbench.harness.run.spec import make_run_spec
 
 
@@ -77,7 +78,8 @@ def print_summary(row: dict, from_store: bool = False, store_path=None) -> None:
     origin = " (from the store; --rerun to run again)" if from_store else ""
     print(f"{row['scene_name']}  {row['engine']}[{row['preset']}]  dt = {row['time_step']:g}  "
           f"horizon = {row['horizon']:g}{origin}")
-    print(f"  status: {row['status']}" + (f" — {row['message']}" if row["message"] else ""))
+    verdict = verdict_text(run_verdict(row["status"], row["expectations_passed"]))
+    print(f"  verdict: {verdict}" + (f" — {row['message']}" if row["message"] else ""))
     if row["engine_status"] != row["status"]:
         print(f"  engine reported: {row['engine_status']} {row['engine_message']}".rstrip())
     print(f"  engine: {row['engine_version']}")

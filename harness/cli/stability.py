@@ -12,6 +12,7 @@ from clearbench.harness.cli.common import (
     open_store,
 )
 from clearbench.harness.measure.headline import METRIC_LABELS, format_value
+from clearbench.harness.measure.verdicts import run_verdict, verdict_text
 from clearbench.harness.studies.stability import (
     STIFF_TAG,
     available_engines,
@@ -27,7 +28,8 @@ def register(subparsers) -> None:
         description="Run every scene tagged 'stiff' (tight clearances, mass ratio 1e4, stiff "
         "springs, 10x steps, tunnelling impacts, mu = 2, e = 1, 100+ contacts, millimetre parts "
         "in SI units) in each engine at the case's own step, and print each engine's verdict "
-        "(ok / diverged / crashed / timed_out / unsupported) with the metrics of the case.",
+        "(pass / physics failed / diverged / crashed / timed out / unsupported) with the metrics "
+        "of the case.",
     )
     parser.add_argument("--engines", "-e", nargs="+", default=None, metavar="ENGINE[PRESET]",
                         help="engines (default: every available engine, default preset)")
@@ -54,11 +56,10 @@ def run_stability(args: argparse.Namespace) -> int:
         if row["case"] != case:
             case = row["case"]
             print(f"\n{case}: {row['summary']}")
-        passed = {1: "expectations pass", 0: "expectation FAILED"}.get(
-            row["expectations_passed"], "")
+        verdict = verdict_text(run_verdict(row["status"], row["expectations_passed"]))
         figures = ", ".join(f"{METRIC_LABELS.get(n, (n,))[0]} {format_value(v)}"
                             for n, v in row["metrics"].items())
-        print(f"  {row['engine']:<24} {row['status']:<11} {passed}")
+        print(f"  {row['engine']:<24} {verdict}")
         if row["reason"] and row["status"] != "ok":
             print(f"  {'':<24} {row['reason']}")
         if figures:

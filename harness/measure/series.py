@@ -32,7 +32,12 @@ from clearbench.scenarios.loads import (
     TorsionalSpringDamper,
 )
 from clearbench.scenarios.outputs import BodyAngle, ContactForce, PointDistance, PointPosition
-from clearbench.scenarios.scales import body_size
+from clearbench.scenarios.scales import (
+    body_size,
+    contact_feature_sizes,
+    scene_size,
+    shape_dimensions,
+)
 from clearbench.scenarios.scene import Scene
 
 
@@ -40,23 +45,123 @@ def _poses(trajectory: Trajectory, body: int) -> tuple[np.ndarray, np.ndarray]:
     return trajectory.positions[:, body], quat_normalize_batch(trajectory.orientations[:, body])
 
 
-def contact_gaps(scene: Scene, trajectory: Trajectory) -> np.ndarray:
-    """Smallest gap of each contact pair (explicit and clearance-joint pairs), minus its offset,
-    (T, npair) [L]; +inf where a pair yields no candidate."""
+#: The last (scene, trajectory, gaps) of :func:`contact_gaps`: a run's measurement asks for
+#: the same gaps several times (penetration, contact energy, contact-free samples) and they cost
+#: one geometry call per pair and sample.
+_LAST_GAPS: list = [None, None, None]
+
+
+def _pair_shapes(scene: Scene):
+    """Per contact pair of ``scene.expanded``: (contact, body index A, shape A, body index B,
+    shape B)."""
     expanded = scene.expanded
     index = {b.name: i for i, b in enumerate(expanded.bodies)}
-    out = np.full((len(trajectory.times), len(expanded.contacts)), np.inf)
-    for k, contact in enumerate(expanded.contacts):
-        body_a = expanded.bodies[index[contact.body_a]]
-        body_b = expanded.bodies[index[contact.body_b]]
-        shape_a = body_a.shape(contact.shape_a)
-        shape_b = body_b.shape(contact.shape_b)
-        xa, qa = _poses(trajectory, index[contact.body_a])
-        xb, qb = _poses(trajectory, index[contact.body_b])
+    for contact in expanded.contacts:
+        a, b = index[contact.body_a], index[contact.body_b]
+        yield (contact, a, expanded.bodies[a].shape(contact.shape_a),
+               b, expanded.bodies[b].shape(contact.shape_b))
+
+
+def _smallest_gap(contact, shape_a, pose_a, shape_b, pose_b) -> float:
+    """Smallest gap of one pair at one configuration minus its offset [L]; inf without a
+    candidate."""
+    result = contacts_between(shape_a, pose_a, shape_b, pose_b)
+    return float(np.min(result.gap)) - contact.offset if len(result.gap) else math.inf
+
+
+def contact_gaps(scene: Scene, trajectory: Trajectory) -> np.ndarray:
+    """Smallest gap of each contact pair (explicit and clearance-joint pairs), minus its offset,
+    (T, npair) [L]; +inf where a pair yields no candidate. Read-only; computed once per
+    (scene, trajectory) pair in a row."""
+    if _LAST_GAPS[0] is scene and _LAST_GAPS[1] is trajectory:
+        return _LAST_GAPS[2]
+    out = np.full((len(trajectory.times), len(scene.expanded.contacts)), np.inf)
+    for k, (contact, a, shape_a, b, shape_b) in enumerate(_pair_shapes(scene)):
+        xa, qa = _poses(trajectory, a)
+        xb, qb = _poses(trajectory, b)
         for t in range(len(trajectory.times)):
-            result = contacts_between(shape_a, (xa[t], qa[t]), shape_b, (xb[t], qb[t]))
-            if len(result.gap):
-                out[t, k] = float(np.min(result.gap)) - contact.offset
+            out[t, k] = _smallest_gap(contact, shape_a, (xa[t], qa[t]), shape_b, (xb[t], qb[t]))
+    out.flags.writeable = False
+    _LAST_GAPS[:] = [scene, trajectory, out]
+    return out
+
+
+#: Most interpolated configurations tested between two recorded samples of one pair.
+MAX_SWEPT_SUBSTEPS = 1000
+
+
+def _rotation_angles(orientations: np.ndarray) -> np.ndarray:
+    """(T - 1, nb) angle of the rotation of each body between consecutive samples [rad]."""
+    q = quat_normalize_batch(orientations)
+    dot = np.abs(np.sum(q[1:] * q[:-1], axis=-1))
+    return 2.0 * np.arccos(np.clip(dot, 0.0, 1.0))
+
+
+def _shape_reach(shape, fallback: float) -> float:
+    """Farthest a point of the shape can be from its frame origin [L] (``fallback``, the
+    scene's size, for an unbounded plane)."""
+    dimensions = [float(d) for d in shape_dimensions(shape)]
+    return float(np.linalg.norm(dimensions)) if dimensions else fallback
+
+
+def _interpolated_pose(com0, com1, q0, q1, local_com, s: float):
+    """Body-frame pose at fraction ``s`` of the straight path between two samples: centre of
+    mass moved linearly, orientation normalised-linearly (nlerp on the short arc)."""
+    q1 = q1 if float(np.dot(q0, q1)) >= 0.0 else -q1
+    q = (1.0 - s) * q0 + s * q1
+    q = q / np.linalg.norm(q)
+    com = (1.0 - s) * com0 + s * com1
+    return com - quat_rotate_batch(q[None, :], local_com[None, :])[0], q
+
+
+def swept_penetration(scene: Scene, trajectory: Trajectory) -> np.ndarray:
+    """Largest penetration max(0, -gap) of each contact pair on the straight path between two
+    consecutive recorded samples, (npair,) [L] (0 where no interval needs testing).
+
+    A body that crosses a thin shape between two samples (a ball through a plate) has a
+    positive gap at both; this swept test catches it. For each pair and interval it bounds
+    how far any point of either shape moves (shape origin displacement plus the shape's reach
+    times its rotation angle); an interval is tested when that motion exceeds half the pair's
+    smallest feature (:func:`~clearbench.scenarios.scales.contact_feature_sizes`: a slower
+    crossing shows on a sample) and exceeds the smaller end gap (otherwise the shapes cannot
+    meet in between). It is then cut into steps of at most half that feature (at most
+    :data:`MAX_SWEPT_SUBSTEPS`), the poses interpolated by :func:`_interpolated_pose`.
+    """
+    gaps = contact_gaps(scene, trajectory)
+    features = contact_feature_sizes(scene)
+    out = np.zeros(len(features))
+    count = len(trajectory.times)
+    if count < 2 or not len(features):
+        return out
+    expanded = scene.expanded
+    size = scene_size(scene)
+    angles = _rotation_angles(trajectory.orientations)
+    q = quat_normalize_batch(trajectory.orientations)
+    local_coms = [np.asarray(b.center_of_mass, dtype=float) for b in expanded.bodies]
+    coms = trajectory.positions + quat_rotate_batch(
+        q, np.broadcast_to(np.array(local_coms), q.shape[:-1] + (3,)))
+    for k, (contact, a, shape_a, b, shape_b) in enumerate(_pair_shapes(scene)):
+        feature = float(features[k])
+        if not math.isfinite(feature) or feature <= 0.0:
+            continue
+        motion = np.zeros(count - 1)
+        for body, shape in ((a, shape_a), (b, shape_b)):
+            origin = trajectory.positions[:, body] + quat_rotate_batch(
+                q[:, body], np.broadcast_to(np.asarray(shape.position, dtype=float),
+                                            (count, 3)))
+            motion += np.linalg.norm(np.diff(origin, axis=0), axis=1)
+            motion += _shape_reach(shape, size) * angles[:, body]
+        ends = np.minimum(gaps[:-1, k], gaps[1:, k])
+        for i in np.nonzero((motion > 0.5 * feature) & (ends < motion))[0]:
+            steps = min(MAX_SWEPT_SUBSTEPS, math.ceil(motion[i] / (0.5 * feature)))
+            for s in np.arange(1, steps) / steps:
+                pose_a = _interpolated_pose(coms[i, a], coms[i + 1, a], q[i, a], q[i + 1, a],
+                                            local_coms[a], s)
+                pose_b = _interpolated_pose(coms[i, b], coms[i + 1, b], q[i, b], q[i + 1, b],
+                                            local_coms[b], s)
+                gap = _smallest_gap(contact, shape_a, pose_a, shape_b, pose_b)
+                if math.isfinite(gap):
+                    out[k] = max(out[k], -gap)
     return out
 
 
@@ -144,6 +249,27 @@ def joint_violation(scene: Scene, trajectory: Trajectory) -> JointViolation:
     return JointViolation(names, distance, angle)
 
 
+def driver_deviation(scene: Scene, trajectory: Trajectory) -> np.ndarray:
+    """|followed - prescribed| displacement of every driver's component since t = 0, (T, nd)
+    [L for translations, rad for rotations]: the centre of mass along the driver's world axis,
+    or the body's rotation about it (:func:`body_angle`), against
+    :meth:`~clearbench.scenarios.drivers.Driver.displacement`."""
+    out = np.zeros((len(trajectory.times), len(scene.drivers)))
+    com = centre_of_mass_positions(scene, trajectory)
+    for d, driver in enumerate(scene.drivers):
+        b = scene.body_index(driver.body)
+        if driver.is_rotation:
+            axis = np.zeros(3)
+            axis[driver.axis_index] = 1.0
+            followed = body_angle(trajectory, b, axis)
+        else:
+            followed = com[:, b, driver.axis_index] - com[0, b, driver.axis_index]
+        prescribed = np.asarray(driver.displacement(trajectory.times - trajectory.times[0]),
+                                dtype=float)
+        out[:, d] = np.abs(followed - prescribed)
+    return out
+
+
 def quaternion_norm_error(trajectory: Trajectory) -> np.ndarray:
     """| |p| - 1 | of every body, (T, nb), as the engine returned it (not renormalised)."""
     return np.abs(np.linalg.norm(trajectory.orientations, axis=2) - 1.0)
@@ -187,20 +313,48 @@ def stiction(scene: Scene, trajectory: Trajectory, body: str, start: float = 0.0
 
 @dataclass(frozen=True)
 class Energy:
-    """(T,) kinetic, gravitational potential and spring potential energy, and their total
-    [M L^2 / T^2]. Time-switched forces, moments and drivers do work not counted here, and so
-    do law loads (``angle_law``, ``distance_law``): their forces are not the gradient of a
-    potential in general (a torsion law applied as a force on a body-fixed lever, a distance
+    """(T,) kinetic, gravitational potential, spring potential and contact energy, and their
+    total [M L^2 / T^2]. Time-switched forces, moments and drivers do work not counted here,
+    and so do law loads (``angle_law``, ``distance_law``): their forces are not the gradient of
+    a potential in general (a torsion law applied as a force on a body-fixed lever, a distance
     law pushing along a body axis), so no potential energy exists to count for them; see
-    :func:`non_conservative_loads`."""
+    :func:`non_conservative_loads`. ``contacts`` is the elastic energy stored in the contacts
+    (:func:`contact_energy`)."""
 
     kinetic: np.ndarray
     gravity: np.ndarray
     springs: np.ndarray
+    contacts: np.ndarray | float = 0.0
 
     @property
     def total(self) -> np.ndarray:
-        return self.kinetic + self.gravity + self.springs
+        return self.kinetic + self.gravity + self.springs + self.contacts
+
+    def at(self, samples: np.ndarray) -> Energy:
+        """The same energies on a subset of the samples (boolean mask or indices)."""
+        contacts = self.contacts[samples] if np.ndim(self.contacts) else self.contacts
+        return Energy(self.kinetic[samples], self.gravity[samples], self.springs[samples],
+                      contacts)
+
+
+def contact_energy(scene: Scene, trajectory: Trajectory) -> np.ndarray:
+    """Elastic energy stored in the contacts, (T,) [M L^2 / T^2]: per pair, half the normal
+    force times the penetration, the work of a linear contact spring pressed to that depth,
+    summed over the pairs.
+
+    The force is the engine's (``contact_normal_force``, the mean over the recorded step, summed
+    over the pair's points), the penetration the harness's (deepest point of the pair). A rigid
+    engine has no penetration and so no stored energy; a compliant one stores, at the deepest
+    moment of an impact, the kinetic energy it took. Damping in the engine's force law, a
+    nonlinear law, and a pair loaded on several points unevenly make this an estimate; a
+    pulling (negative) normal force stores nothing."""
+    count = len(trajectory.times)
+    if not scene.all_contacts or trajectory.contact_normal_force.shape != (
+            count, len(scene.expanded.contacts)):
+        return np.zeros(count)
+    depth = penetration(scene, trajectory)
+    force = np.maximum(0.0, np.nan_to_num(trajectory.contact_normal_force, nan=0.0))
+    return 0.5 * np.sum(force * depth, axis=1)
 
 
 def energy(scene: Scene, trajectory: Trajectory) -> Energy:
@@ -231,7 +385,7 @@ def energy(scene: Scene, trajectory: Trajectory) -> Energy:
             phi = relative_angle(trajectory, scene.body_index(load.body_a),
                                  scene.body_index(load.body_b), load.axis)
             springs += load.preload * phi + 0.5 * load.stiffness * (phi - load.rest_angle) ** 2
-    return Energy(kinetic, potential, springs)
+    return Energy(kinetic, potential, springs, contact_energy(scene, trajectory))
 
 
 def non_conservative_loads(scene: Scene) -> tuple[str, ...]:
@@ -319,19 +473,31 @@ def contact_free(scene: Scene, trajectory: Trajectory) -> np.ndarray:
     return np.all(contact_gaps(scene, trajectory) > 0.0, axis=1)
 
 
+def _largest_rise(values: Energy) -> float:
+    total = values.total
+    return float(np.max(total - np.minimum.accumulate(total)))
+
+
 def energy_growth(scene: Scene, trajectory: Trajectory,
                   values: Energy | None = None) -> tuple[float, float]:
-    """Largest rise of the total energy above its running minimum, and the energy scale it is
-    judged against, both [M L^2/T^2] and both over the same samples.
+    """Largest rise of the total energy, contact energy included (:func:`contact_energy`),
+    above its running minimum, on every sample, and the energy scale it is judged against
+    (:func:`energy_scale`), both [M L^2/T^2]. A compliant engine stores the energy of an
+    elastic impact in the contact and gives it back: counted, that is no gain."""
+    values = values if values is not None else energy(scene, trajectory)
+    return _largest_rise(values), energy_scale(scene, values)
 
-    Measured on the samples where every contact is open when there are at least two of them:
-    a compliant engine stores energy in a closed contact that :func:`energy` does not count
-    (its contact potential), and gives it back, which would read as a gain; between contacts
-    the count is complete. Scenes that never leave contact are measured on every sample.
-    """
+
+def energy_growth_contact_free(scene: Scene, trajectory: Trajectory,
+                               values: Energy | None = None) -> tuple[float, float]:
+    """The cross-check of :func:`energy_growth` that needs no contact force: the same rise
+    and scale without the contact energy, on the samples where every contact is open (all
+    samples when fewer than two are). It misses growth during contact, and a scene that never
+    opens every contact (a row of balls on a floor) is measured on every sample without the
+    energy stored in its contacts."""
     values = values if values is not None else energy(scene, trajectory)
     free = contact_free(scene, trajectory)
+    values = Energy(values.kinetic, values.gravity, values.springs)
     if np.count_nonzero(free) >= 2:
-        values = Energy(values.kinetic[free], values.gravity[free], values.springs[free])
-    total = values.total
-    return float(np.max(total - np.minimum.accumulate(total))), energy_scale(scene, values)
+        values = values.at(free)
+    return _largest_rise(values), energy_scale(scene, values)

@@ -1,6 +1,21 @@
-"""Pass/fail criteria: of each expectation in the harness's results and report, and which
-expectation figure is a run's analytic error. (The run's own verdict, ok or diverged, is
-:func:`clearbench.harness.measure.figures.measure`'s.)
+"""Pass/fail criteria: of each expectation in the harness's results and report, which
+expectation figure is a run's analytic error, and the one verdict of a run that the overview
+matrix and the CLI show (:func:`run_verdict`, from the run's status and its expectations).
+(The run's status, ok or diverged, is :func:`clearbench.harness.measure.figures.measure`'s.)
+
+The verdict of a run (:data:`VERDICTS`: label -> symbol, colour, meaning):
+
+===============  ======  ===============================================================
+verdict          symbol  when
+===============  ======  ===============================================================
+pass             ✓       finished (status ok) and every expectation judged passed
+physics failed   ✗       finished, but an expectation of the scene failed
+no check         ○       finished, and the scene has no expectation that could be judged
+diverged         ↯       NaN, energy gain, escape, tunnelling, a joint or driver broken
+crashed          ☠       the engine or its worker died or raised
+timed out        ⌛      the wall-clock limit was reached
+unsupported      ∅       the engine cannot represent the scene (it says why)
+===============  ======  ===============================================================
 
 :func:`clearbench.harness.measure.expectation_figures.evaluate` states figures, not verdicts:
 what is acceptable depends on the use. These are the harness's criteria (shown in the report), each
@@ -32,6 +47,7 @@ The headline error of a run where the scene has an analytic reference is the lar
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 from clearbench.scenarios.scales import body_size, smallest_contact_feature
 from clearbench.scenarios.scene import Scene
@@ -109,3 +125,52 @@ def judge(scene: Scene, kind: str, body: str | None, figures: dict) -> tuple[boo
         bound = 0.01 * smallest_contact_feature(scene)
         return _within(get("penetration_max"), bound), f"penetration <= {bound:.3g}"
     return None, "no criterion"
+
+
+@dataclass(frozen=True)
+class VerdictStyle:
+    """How a verdict is shown: a symbol (readable in print and without colour vision), a
+    background colour, and what it means."""
+
+    symbol: str
+    colour: str
+    meaning: str
+
+
+#: Every verdict of :func:`run_verdict`, best first. Colours are light tints told apart by
+#: lightness as well as hue; the symbol carries the verdict on its own.
+VERDICTS: dict[str, VerdictStyle] = {
+    "pass": VerdictStyle("✓", "#cde9d0", "finished; every expectation of the scene passed"),
+    "physics failed": VerdictStyle("✗", "#ffd98a", "finished, but an expectation of the scene "
+                                   "failed (wrong physics)"),
+    "no check": VerdictStyle("○", "#f2f2f2", "finished; no expectation of the scene could be "
+                             "judged"),
+    "diverged": VerdictStyle("↯", "#f2a08f", "stopped or judged broken: NaN, energy gain, "
+                             "escape, tunnelling, a joint or driver broken"),
+    "crashed": VerdictStyle("☠", "#c9a3d9", "the engine or its worker died or raised"),
+    "timed out": VerdictStyle("⌛", "#a9c8ec", "the wall-clock limit was reached"),
+    "unsupported": VerdictStyle("∅", "#d6d6d6", "the engine cannot represent the scene"),
+}
+
+#: Run status (:class:`~clearbench.adapters.trajectory.RunStatus` value) -> verdict, for every
+#: status but ok (whose verdict depends on the expectations).
+_STATUS_VERDICTS = {"diverged": "diverged", "crashed": "crashed", "timed_out": "timed out",
+                    "unsupported": "unsupported"}
+
+
+def run_verdict(status: str, expectations_passed) -> str:
+    """The verdict of a run (a key of :data:`VERDICTS`) from its stored status and its
+    ``expectations_passed`` (1 all judged passed, 0 one failed, None or NaN none judged)."""
+    if status != "ok":
+        if status not in _STATUS_VERDICTS:
+            raise ValueError(f"unknown run status {status!r}")
+        return _STATUS_VERDICTS[status]
+    if expectations_passed is None or (isinstance(expectations_passed, float)
+                                       and math.isnan(expectations_passed)):
+        return "no check"
+    return "pass" if int(expectations_passed) else "physics failed"
+
+
+def verdict_text(verdict: str) -> str:
+    """Symbol and name of a verdict, e.g. ``"✗ physics failed"``."""
+    return f"{VERDICTS[verdict].symbol} {verdict}"

@@ -30,6 +30,7 @@ from clearbench.harness.measure.headline import (
     headline,
     scene_metric_names,
 )
+from clearbench.harness.measure.verdicts import VERDICTS, run_verdict, verdict_text
 from clearbench.harness.report.c60_section import C60Section, build_section
 from clearbench.harness.report.c60_section import section_html as c60_engines_html
 from clearbench.harness.report.c60_section import section_markdown as c60_engines_markdown
@@ -144,17 +145,19 @@ def _figures(store: ResultsStore, section: SceneSection) -> None:
 
 # ---------------------------------------------------------------------------- content helpers
 def _cell(row: dict | None, scene: Scene | None) -> tuple[str, str, str]:
-    """(status, headline text, title) of an overview cell."""
+    """(verdict (a key of VERDICTS, "" when not run), headline figure, title: the run's
+    message and its failed expectations) of an overview cell."""
     if row is None:
         return "", "not run", ""
     figures = json.loads(row["metrics"] or "{}")
     name, value = headline(scene, figures) if scene is not None else ("", math.nan)
     label = METRIC_LABELS.get(name, (name, ""))[0]
     text = f"{label} {format_value(value)}" if name else ""
-    passed = row.get("expectations_passed")
-    if passed is not None and not (isinstance(passed, float) and math.isnan(passed)):
-        text += " ✓" if int(passed) else " ✗ expectation"
-    return row["status"], text, row.get("message") or ""
+    failed = [r["name"] for r in json.loads(row.get("expectations") or "[]")
+              if r.get("passed") is False]
+    title = "; ".join(filter(None, [row.get("message") or "",
+                                    f"failed: {', '.join(failed)}" if failed else ""]))
+    return run_verdict(row["status"], row.get("expectations_passed")), text, title
 
 
 def _metric_columns(section: SceneSection) -> list[str]:
@@ -218,6 +221,28 @@ def _status_td(status: str, text: str = "", title: str = "") -> str:
     return f"<td style='background:{colour}' title='{_esc(title)}'>{body}</td>"
 
 
+def _verdict_td(verdict: str, text: str, title: str, scene: str, engine: str) -> str:
+    """An overview cell: the verdict's colour, symbol and name, the headline figure under it;
+    ``data-*`` attributes name the scene, engine and verdict for tools reading the page."""
+    style = VERDICTS.get(verdict)
+    colour = style.colour if style else "#ffffff"
+    body = f"<span class='status'>{_esc(verdict_text(verdict))}</span>" if style else ""
+    if text:
+        body += f"<br><span class='small'>{_esc(text)}</span>"
+    return (f"<td class='verdict' data-scene='{_esc(scene)}' data-engine='{_esc(engine)}' "
+            f"data-verdict='{_esc(verdict or 'not run')}' style='background:{colour}' "
+            f"title='{_esc(title)}'>{body}</td>")
+
+
+def _verdict_legend_html() -> str:
+    items = "".join(f"<tr><td style='background:{style.colour}'><span class='status'>"
+                    f"{_esc(verdict_text(name))}</span></td><td>{_esc(style.meaning)}</td></tr>"
+                    for name, style in VERDICTS.items())
+    return (f"<table class='legend'><tr><th>verdict</th><th>meaning</th></tr>{items}</table>"
+            "<p class='small'>Under the verdict: the scene's headline figure. Hover a cell for "
+            "the run's message and the expectations it failed (docs/harness.md: verdicts).</p>")
+
+
 def _overview_html(data: ReportData, stiff: bool) -> str:
     sections = [s for s in data.sections
                 if (s.scene is not None and "stiff" in s.scene.tags) == stiff]
@@ -226,16 +251,20 @@ def _overview_html(data: ReportData, stiff: bool) -> str:
     head = "".join(f"<th>{_esc(label)}</th>" for label in data.engines)
     body = []
     for section in sections:
-        cells = "".join(_status_td(*_cell(section.representative.get(label), section.scene))
+        cells = "".join(_verdict_td(*_cell(section.representative.get(label), section.scene),
+                                    section.name, label)
                         for label in data.engines)
         step = f"{section.scene.time_step:g} {section.scene.units.time}" if section.scene else ""
         body.append(f"<tr><td><a href='#scene-{_esc(section.name)}'>{_esc(section.name)}</a>"
                     f"<br><span class='small'>dt {step}</span></td>{cells}</tr>")
     title = "Stiff and extreme suite" if stiff else "Overview"
     note = ("each engine at the case's own (hard) step" if stiff else
-            "each engine at the scene's comfortable step; the headline metric of the scene")
-    return (f"<h2>{title}</h2><p class='small'>{note}; ✓/✗: expectations of the scene.</p>"
-            f"<table><tr><th>scene</th>{head}</tr>{''.join(body)}</table>")
+            "each engine at the scene's comfortable step")
+    table_id = "stiff-matrix" if stiff else "overview-matrix"
+    return (f"<h2>{title}</h2><p class='small'>{note}: one verdict per run, from its status and "
+            "the scene's expectations together, and the scene's headline figure.</p>"
+            f"<table id='{table_id}'><tr><th>scene</th>{head}</tr>{''.join(body)}</table>"
+            + ("" if stiff else _verdict_legend_html()))
 
 
 def _runs_table_html(section: SceneSection) -> str:
@@ -442,10 +471,14 @@ def render_markdown(data: ReportData, figure_files: dict, c60_figure_files: dict
         for section in sections:
             cells = []
             for label in data.engines:
-                status, text, _ = _cell(section.representative.get(label), section.scene)
-                cells.append(_md_escape(f"**{status}** {text}".strip() if status else text))
+                verdict, text, _ = _cell(section.representative.get(label), section.scene)
+                cells.append(_md_escape(f"**{verdict_text(verdict)}** {text}".strip()
+                                        if verdict else text))
             lines.append(f"| {section.name} | " + " | ".join(cells) + " |")
         lines.append("")
+        if not stiff:
+            lines += ["Verdicts: " + "; ".join(f"{verdict_text(name)}: {style.meaning}"
+                                                for name, style in VERDICTS.items()) + ".", ""]
     if data.c60_engines:
         lines += c60_engines_markdown(data.c60_engines, c60_engines_figure)
     if data.c60_validation:

@@ -692,11 +692,17 @@ class SiconosModel:
         self.td = sk.TimeDiscretisation(0.0, self.h)
         theta = float(settings["theta"])
         if self.joint_interactions:
-            # Local contact solver NSN_GP_HYBRID (Newton with line search): the default
-            # ONECONTACT_NSN failed on fast-sliding contacts (Flores slider: residual 0.2,
-            # the slider went through its guide).
-            self.osnspb = sk.GenericMechanical(sn.SICONOS_FRICTION_3D_ONECONTACT_NSN_GP_HYBRID)
-            self.problem = (f"GenericMechanical (NSGS, local NSN_GP_HYBRID, equalities: "
+            # GenericMechanical's only solver is NSGS over its blocks (Siconos 4.4); the
+            # preset's solver chooses the local solver of each contact block. "nsgs": Newton
+            # with line search, NSN_GP_HYBRID (the plain ONECONTACT_NSN failed on fast-sliding
+            # contacts: Flores slider, residual 0.2, the slider went through its guide);
+            # "nsn-ac": the Alart-Curnier Newton without line search, ONECONTACT_NSN.
+            local_name, local_solver = {
+                "nsgs": ("NSN_GP_HYBRID", sn.SICONOS_FRICTION_3D_ONECONTACT_NSN_GP_HYBRID),
+                "nsn-ac": ("NSN (Alart-Curnier)", sn.SICONOS_FRICTION_3D_ONECONTACT_NSN),
+            }[settings["solver"]]
+            self.osnspb = sk.GenericMechanical(local_solver)
+            self.problem = (f"GenericMechanical (NSGS, local {local_name}, equalities: "
                             f"{settings['gmp_reduction']})")
         else:
             solver = {"nsgs": sn.SICONOS_FRICTION_3D_NSGS,

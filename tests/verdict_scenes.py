@@ -1,0 +1,84 @@
+"""Scenes written for the verdict tests (not in the library): a row of three balls with
+elastic impacts on a floor, and a planar linkage whose driven ends pull a joint apart.
+
+SI units (m, kg, s).
+"""
+
+from __future__ import annotations
+
+from clearbench.scenarios.bodies import Body, Motion
+from clearbench.scenarios.contacts import ContactPair
+from clearbench.scenarios.drivers import Driver
+from clearbench.scenarios.expectations import Expectation
+from clearbench.scenarios.inertia import diagonal, solid_sphere
+from clearbench.scenarios.joints import PrismaticJoint, RevoluteJoint
+from clearbench.scenarios.scene import Scene
+from clearbench.scenarios.shapes import Plane, Sphere
+
+GRAVITY = 9.81  # m/s^2
+Z_AXIS = (0.0, 0.0, 1.0)
+
+
+def elastic_row(speed: float = 1.0, radius: float = 0.05, mass: float = 0.2) -> Scene:
+    """Three equal balls resting on a frictionless floor in a row along x; the first, ``2
+    radius`` away from the two touching others, moves at ``speed`` [m/s] toward them. The
+    ball-ball impacts are elastic (e = 1), the floor holds them (e = 0): the energy is
+    conserved, and in the end the first two balls are at rest and the third moves at
+    ``speed``. At least one contact (the floor) is closed on every sample."""
+    balls = []
+    for index, x in enumerate((-4.0 * radius, 0.0, 2.0 * radius)):
+        balls.append(Body(f"ball{index}", mass=mass, inertia=solid_sphere(mass, radius),
+                          position=(x, 0.0, radius),
+                          velocity=(speed if index == 0 else 0.0, 0.0, 0.0),
+                          shapes=(Sphere("sphere", radius=radius),)))
+    floor = Body("ground", motion=Motion.FIXED, shapes=(Plane("floor"),))
+    contacts = [ContactPair(f"floor_{b.name}", body_a="ground", shape_a="floor",
+                            body_b=b.name, shape_b="sphere") for b in balls]
+    contacts += [ContactPair(f"{a.name}_{b.name}", body_a=a.name, shape_a="sphere",
+                             body_b=b.name, shape_b="sphere", restitution=1.0)
+                 for a, b in zip(balls, balls[1:], strict=False)]
+    return Scene(
+        name="elastic-row",
+        description="Three balls in a row on a frictionless floor, elastic impacts between "
+        "them: the first one's momentum passes to the third.",
+        horizon=0.3, time_step=1e-3, bodies=(floor, *balls), contacts=tuple(contacts),
+        expectations=(Expectation("energy", kind="energy_non_increasing"),),
+    )
+
+
+def pulled_apart_linkage(pull_speed: float = 0.5, crank_length: float = 0.1,
+                         rod_length: float = 0.3) -> Scene:
+    """The library's slider-crank at full extension (crank angle 0, slider at crank + rod from
+    the pivot), with the slider driven further out along x at ``pull_speed`` [m/s] while the
+    crank turns at 10 rad/s: no motion of the rod keeps both its pins, so an ideal joint must
+    come apart (0.1 m, a quarter of the linkage, in the 0.2 s horizon)."""
+    l1, l2 = crank_length, rod_length
+    crank = Body("crank", mass=0.1, inertia=diagonal(1e-5, 1e-4, 1e-4),
+                 angular_velocity=(0.0, 0.0, 10.0), motion=Motion.DRIVEN)
+    rod = Body("rod", mass=0.2, inertia=diagonal(0.2 * l2**2 / 1200, 0.2 * l2**2 / 12,
+                                                 0.2 * l2**2 / 12),
+               center_of_mass=(0.5 * l2, 0.0, 0.0), position=(l1, 0.0, 0.0),
+               velocity=(0.0, 0.5 * l1 * 10.0, 0.0))
+    slider = Body("slider", mass=0.3, inertia=diagonal(1e-4, 1e-4, 1e-4),
+                  position=(l1 + l2, 0.0, 0.0), velocity=(pull_speed, 0.0, 0.0),
+                  motion=Motion.DRIVEN)
+    return Scene(
+        name="pulled-apart-linkage",
+        description="A slider-crank at full extension whose slider is driven outward: a pin "
+        "must come apart.",
+        gravity=(0.0, 0.0, -GRAVITY), horizon=0.2, time_step=1e-3,
+        bodies=(Body("ground", motion=Motion.FIXED), crank, rod, slider),
+        joints=(
+            RevoluteJoint("crank_pivot", body_a="ground", body_b="crank", axis=Z_AXIS),
+            RevoluteJoint("crank_pin", body_a="crank", body_b="rod", anchor=(l1, 0.0, 0.0),
+                          axis=Z_AXIS),
+            RevoluteJoint("wrist_pin", body_a="rod", body_b="slider",
+                          anchor=(l1 + l2, 0.0, 0.0), axis=Z_AXIS),
+            PrismaticJoint("slide", body_a="ground", body_b="slider",
+                           anchor=(l1 + l2, 0.0, 0.0), axis=(1.0, 0.0, 0.0)),
+        ),
+        drivers=(Driver("crank_drive", body="crank", component="rz", times=(0.0,),
+                        values=(10.0,)),
+                 Driver("pull", body="slider", component="x", times=(0.0,),
+                        values=(pull_speed,))),
+    )
