@@ -134,3 +134,59 @@ def test_a_campaign_runs_any_named_variant_through_scene_parameters():
     broken = with_overrides(study, samples=1, scene_parameters={"variant": "nope"})
     with pytest.raises(CampaignError, match="variant"):
         plan_samples(broken)
+
+
+def _solids(path):
+    """Volume [mm3] and centroid [mm] of each solid of a STEP file (OpenCASCADE)."""
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+    from OCP.STEPControl import STEPControl_Reader
+    from OCP.TopAbs import TopAbs_SOLID
+    from OCP.TopExp import TopExp_Explorer
+
+    reader = STEPControl_Reader()
+    reader.ReadFile(str(path))
+    reader.TransferRoots()
+    explorer = TopExp_Explorer(reader.OneShape(), TopAbs_SOLID)
+    out = []
+    while explorer.More():
+        properties = GProp_GProps()
+        BRepGProp.VolumeProperties_s(explorer.Current(), properties)
+        centre = properties.CentreOfMass()
+        out.append((properties.Mass(), (centre.X(), centre.Y(), centre.Z())))
+        explorer.Next()
+    return out
+
+
+#: Densities [g/cm3] telling the materials apart: moulded plastics (filled ones included) are
+#: below 2.2, steel and copper alloys above 7; nothing of the mechanism lies in between.
+PLASTIC_BELOW, METAL_ABOVE = 2.2, 7.0
+
+
+def test_part_materials_follow_from_the_sheet_masses_and_the_cad_volumes():
+    pytest.importorskip("OCP")
+    from tools.c60_cad.extract import CAD_DIR
+
+    for body in model.load_model()["bodies"]:
+        material = variants.PART_MATERIALS[body["name"]][0]
+        if body["name"] in ("plunger", "moving_contact"):
+            continue   # the plunger by its function; the moving contact below
+        mass = body.get("paper_mass", body["mass"])   # g
+        volume = sum(v for v, _ in _solids(CAD_DIR / body["cad"]))   # mm3
+        density = 1e3 * mass / volume   # g/cm3
+        if material == variants.PLASTIC:
+            assert density < PLASTIC_BELOW, body["name"]
+        else:
+            assert density > METAL_ABOVE, body["name"]
+    # The moving contact: two solids whose densities reproduce the sheet's mass and centre of
+    # mass (x and z fix the two masses; y checks them) are a plastic carrier and a metal blade.
+    entry = next(b for b in model.load_model()["bodies"] if b["name"] == "moving_contact")
+    (v1, c1), (v2, c2) = sorted(_solids(CAD_DIR / entry["cad"]))[::-1]   # carrier first
+    x = entry["center_of_mass"][0]
+    blade_mass = entry["mass"] * (x - c1[0]) / (c2[0] - c1[0])
+    carrier_mass = entry["mass"] - blade_mass
+    assert 1e3 * carrier_mass / v1 < PLASTIC_BELOW < METAL_ABOVE < 1e3 * blade_mass / v2
+    y = (carrier_mass * c1[1] + blade_mass * c2[1]) / entry["mass"]
+    # The sheet's y of the centre of mass, to its 4th digit (printed to 7; 1e-3 mm allows
+    # the CAD's B-spline volumes).
+    assert y == pytest.approx(entry["center_of_mass"][1], abs=1e-3)

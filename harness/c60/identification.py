@@ -54,13 +54,25 @@ FCS = ("FC-1", "FC-2", "FC-3", "FC-4", "FC-5", "FC-6")
 @dataclass(frozen=True)
 class Candidate:
     """A variant of the study: which runs it gets and what it is (``source``, ``documented``:
-    a value the source's comments give, ``paper``: the paper's Table 4, ``combination``)."""
+    a value the source's comments give, ``paper``: the paper's Table 4, ``combination``,
+    ``calibration``: ``overrides`` fitted here, not documented by the source)."""
 
     variant: str
     kind: str
     on: bool = True
     trip_test: bool = False
     contact_test: bool = False
+    overrides: tuple = ()   # (ModelParameters field, value) pairs over the variant
+
+    @property
+    def name(self) -> str:
+        """The variant's name, with the overrides of a calibration."""
+        return self.variant + "".join(f"+{key}={value}" for key, value in self.overrides)
+
+    @property
+    def parameters(self) -> dict:
+        """Factory parameters selecting this model."""
+        return {"variant": self.variant, **dict(self.overrides)}
 
 
 #: The study, in the order it runs (the cheap c60-on runs first, the bench tests after).
@@ -134,10 +146,11 @@ def _bar_tilt(run: Run) -> float:
 def identify(cache: Path | None, preset: str = "default",
              candidates: Sequence[Candidate] = CANDIDATES, on_horizon: float = ON_HORIZON,
              progress: Callable[[str], None] | None = None,
-             cached_only: bool = False) -> Identification:
+             cached_only: bool = False, calibrate: bool = True) -> Identification:
     """Run (or read from ``cache``) every candidate's runs and collect the figures; with
     ``cached_only`` only what the cache holds (the rest stays NaN, listed in
-    ``Identification.missing``)."""
+    ``Identification.missing``). With ``calibrate``, then the labelled calibration
+    (:func:`calibration`) when the candidates include its bracket."""
     study = Identification()
     mean_clearances = {joint: MEAN_CLEARANCE for joint in model.JOINTS}
     prototype = model.prototype_clearances()
@@ -153,49 +166,61 @@ def identify(cache: Path | None, preset: str = "default",
             study.runs[key] = done
         return done
 
-    for candidate in candidates:
-        variant = candidate.variant
-        figures = VariantFigures(candidate, model_parameters(variant).label())
-        study.figures.append(figures)
-        if candidate.on:
-            on = run(f"identify_on_mean_{variant}", "c60-on",
-                     {"variant": variant, "clearances": mean_clearances,
-                      "horizon": on_horizon})
-            if on is not None:
-                figures.fc_mean, figures.fc_drift = _fc_values(on)
-                figures.bar_tilt = _bar_tilt(on)
-            proto = run(f"identify_on_prototype_{variant}", "c60-on",
-                        {"variant": variant, "clearances": prototype, "horizon": on_horizon})
-            if proto is not None:
-                figures.fc1_prototype = _fc_values(proto)[0]["FC-1"]
-            for key, done in (("mean", on), ("prototype", proto)):
-                if done is not None and done.trajectory.status.value != "ok":
-                    figures.notes.append(f"c60-on ({key} clearances) ended "
-                                         f"{done.trajectory.status.value}")
-    for candidate, figures in zip(candidates, study.figures, strict=True):
-        if candidate.trip_test:
-            trip = run(f"identify_trip_test_{candidate.variant}", "c60-trip-force-test",
-                       {"variant": candidate.variant}, record_every=20)
-            if trip is None:
-                continue
-            curve = analysis.trip_force_curve(trip.scene, trip.trajectory)
-            figures.trip_peak = curve.peak_force
-            figures.trip_peak_at = curve.peak_displacement
-            figures.trip_distance = curve.trip_distance
-            figures.trip_curve = curve
-    for candidate, figures in zip(candidates, study.figures, strict=True):
-        if candidate.contact_test:
-            test = run(f"identify_contact_test_{candidate.variant}", "c60-contact-force-test",
-                       {"variant": candidate.variant}, record_every=20)
-            if test is None:
-                continue
-            if test.trajectory.status.value == "ok":
-                curve = analysis.contact_force_curve(test.scene, test.trajectory)
-                figures.contact_force = curve.equilibrium_force
-                figures.contact_travel = curve.loaded_travel
-            else:
-                figures.notes.append(f"contact-force test ended "
-                                     f"{test.trajectory.status.value}")
+    def measure(batch: Sequence[Candidate]) -> None:
+        batch_figures = []
+        for candidate in batch:
+            variant = candidate.name
+            figures = VariantFigures(candidate, model_parameters(**candidate.parameters).label())
+            study.figures.append(figures)
+            batch_figures.append(figures)
+            if candidate.on:
+                on = run(f"identify_on_mean_{variant}", "c60-on",
+                         {**candidate.parameters, "clearances": mean_clearances,
+                          "horizon": on_horizon})
+                if on is not None:
+                    figures.fc_mean, figures.fc_drift = _fc_values(on)
+                    figures.bar_tilt = _bar_tilt(on)
+                proto = run(f"identify_on_prototype_{variant}", "c60-on",
+                            {**candidate.parameters, "clearances": prototype,
+                             "horizon": on_horizon})
+                if proto is not None:
+                    figures.fc1_prototype = _fc_values(proto)[0]["FC-1"]
+                for key, done in (("mean", on), ("prototype", proto)):
+                    if done is not None and done.trajectory.status.value != "ok":
+                        figures.notes.append(f"c60-on ({key} clearances) ended "
+                                             f"{done.trajectory.status.value}")
+        for figures in batch_figures:
+            candidate = figures.candidate
+            if candidate.trip_test:
+                trip = run(f"identify_trip_test_{candidate.name}", "c60-trip-force-test",
+                           candidate.parameters, record_every=20)
+                if trip is None:
+                    continue
+                curve = analysis.trip_force_curve(trip.scene, trip.trajectory)
+                figures.trip_peak = curve.peak_force
+                figures.trip_peak_at = curve.peak_displacement
+                figures.trip_distance = curve.trip_distance
+                figures.trip_curve = curve
+        for figures in batch_figures:
+            candidate = figures.candidate
+            if candidate.contact_test:
+                test = run(f"identify_contact_test_{candidate.name}", "c60-contact-force-test",
+                           candidate.parameters, record_every=20)
+                if test is None:
+                    continue
+                if test.trajectory.status.value == "ok":
+                    curve = analysis.contact_force_curve(test.scene, test.trajectory)
+                    figures.contact_force = curve.equilibrium_force
+                    figures.contact_travel = curve.loaded_travel
+                else:
+                    figures.notes.append(f"contact-force test ended "
+                                         f"{test.trajectory.status.value}")
+
+    measure(candidates)
+    if calibrate:
+        fitted = calibration(study)
+        if fitted is not None:
+            measure([fitted])
     return study
 
 
@@ -204,9 +229,35 @@ def identify(cache: Path | None, preset: str = "default",
 # ------------------------------------------------------------------------------------------------
 
 
+#: The calibration's target (Section 5.2, simulated) [N] and the two documented preloads whose
+#: prototype FC-1 it interpolates between [rad].
+CALIBRATION_TARGET = 14.96
+CALIBRATION_BRACKET = ("source", "preload-0.9599")
+
+
+def calibration(study: Identification) -> Candidate | None:
+    """A labelled calibration: the contact-spring preload that puts FC-1 at the prototype's
+    clearances on the paper's simulated 14.96 N (Section 5.2), by linear interpolation between
+    the two documented preloads' runs (0.49 and 0.9599 rad; FC-1 is the moment balance of a law
+    linear in the preload), with the latch at the paper's metal/plastic 0.1 (variant
+    latch-0.1). It is judged on what it was not fitted to: FC-1..FC-6 against the Monte Carlo
+    means and the trip test. None when the bracket's runs are not in ``study``."""
+    by_name = {f.candidate.name: f for f in study.figures}
+    low, high = (by_name.get(name) for name in CALIBRATION_BRACKET)
+    if low is None or high is None or math.isnan(low.fc1_prototype) or math.isnan(
+            high.fc1_prototype):
+        return None
+    preloads = [model_parameters(name).contact_spring_preload for name in CALIBRATION_BRACKET]
+    slope = (high.fc1_prototype - low.fc1_prototype) / (preloads[1] - preloads[0])
+    preload = round(preloads[1] + (CALIBRATION_TARGET - high.fc1_prototype) / slope, 4)
+    return Candidate("latch-0.1", f"calibration: preload fitted to FC-1 prototype "
+                     f"{CALIBRATION_TARGET} N", trip_test=True,
+                     overrides=(("contact_spring_preload", preload),))
+
+
 def candidates(*names: str) -> tuple[Candidate, ...]:
     """The study's candidates of these variant names, in that order."""
-    known = {c.variant: c for c in CANDIDATES}
+    known = {c.name: c for c in CANDIDATES}
     return tuple(known[name] for name in names)
 
 
@@ -286,7 +337,7 @@ def table_lines(study: Identification) -> list[str]:
         contact = ("-" if math.isnan(figures.contact_force) else
                    f"{_f(figures.contact_force, 2)} N, {_f(figures.contact_travel, 3)} mm")
         lines.append(
-            f"| `{figures.candidate.variant}` ({figures.label}) | {figures.candidate.kind} | "
+            f"| `{figures.candidate.name}` ({figures.label}) | {figures.candidate.kind} | "
             f"{_f(figures.fc1_prototype, 2)} | " + " | ".join(cells)
             + f" | {_f(figures.trip_peak, 2)} | {_f(figures.trip_peak_at, 3)} | "
             f"{_f(figures.trip_distance, 3)} | {contact} | "
@@ -323,7 +374,7 @@ def write_markdown(study: Identification, path: Path, preset: str, on_horizon: f
               + ".", ""]
     lines += ["## FC-2..FC-5 against the paper", "",
               analysis.pin_lamage_cause(max(tilts) if tilts else None), ""]
-    notes = [f"- `{f.candidate.variant}`: {'; '.join(f.notes)}" for f in study.figures
+    notes = [f"- `{f.candidate.name}`: {'; '.join(f.notes)}" for f in study.figures
              if f.notes]
     if notes:
         lines += ["## Runs that did not end ok", "", *notes, ""]
@@ -349,9 +400,9 @@ def write_json(study: Identification, path: Path) -> None:
     rows = []
     for figures in study.figures:
         rows.append({
-            "variant": figures.candidate.variant, "kind": figures.candidate.kind,
+            "variant": figures.candidate.name, "kind": figures.candidate.kind,
             "parameters": {k: (dict(v) if k == "friction" else v) for k, v in
-                           model_parameters(figures.candidate.variant).changes().items()},
+                           model_parameters(**figures.candidate.parameters).changes().items()},
             "fc_mean_clearances": {k: number(v) for k, v in figures.fc_mean.items()},
             "fc_sigmas": {k: number(v) for k, v in sigmas(figures).items()},
             "fc1_prototype_N": number(figures.fc1_prototype),

@@ -70,6 +70,9 @@ def register(subparsers) -> None:
     identify.add_argument("--runs", choices=("all", "on", "bench"), default="all",
                           help="all (default), only the c60-on runs, or only the bench tests "
                           "(two processes can share the cache without running a case twice)")
+    identify.add_argument("--no-calibration", action="store_true",
+                          help="skip the labelled calibration (the preload fitted to the "
+                          "prototype's FC-1, judged on the other figures)")
     identify.add_argument("--cached-only", action="store_true",
                           help="write the table from the cached runs only, running nothing")
     identify.set_defaults(handler=run_identify)
@@ -128,7 +131,7 @@ def run_identify(args: argparse.Namespace) -> int:
     candidates = identification.CANDIDATES
     if args.variants:
         wanted = [name.strip() for name in args.variants.split(",") if name.strip()]
-        known = {c.variant: c for c in candidates}
+        known = {c.name: c for c in candidates}
         unknown = [name for name in wanted if name not in known]
         if unknown or not wanted:
             raise UserError(f"--variants {args.variants}: unknown {unknown}; the study's "
@@ -140,7 +143,8 @@ def run_identify(args: argparse.Namespace) -> int:
         candidates = tuple(replace(c, on=False) for c in candidates)
     study = identification.identify(args.cache, args.preset, candidates,
                                     progress=lambda key: print(f"run {key}", flush=True),
-                                    cached_only=args.cached_only)
+                                    cached_only=args.cached_only,
+                                    calibrate=not args.no_calibration)
     lines = identification.table_lines(study)
     print("\n".join(lines))
     identification.write_markdown(study, args.out, args.preset, identification.ON_HORIZON)
