@@ -383,11 +383,11 @@ def write_markdown(study: Identification, path: Path, preset: str, on_horizon: f
                   "(`--cached-only`); their cells are '-': " + ", ".join(study.missing) + ".",
                   ""]
     lines += ["## Runs", "", "| run | scene | status | steps | stepping [s] | unconverged "
-              "steps | max penetration [mm] |", "|---|---|---|---|---|---|---|"]
+              "steps |", "|---|---|---|---|---|---|"]
     for key, run in study.runs.items():
         lines.append(f"| {key} | {run.scene.name} | {run.trajectory.status.value} | "
                      f"{run.trajectory.steps} | {run.trajectory.stepping_seconds:.0f} | "
-                     f"{len(run.unconverged)} | {run.penetration:.1e} |")
+                     f"{len(run.unconverged)} |")
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text("\n".join(lines) + "\n")
 
