@@ -193,6 +193,52 @@ def contact_force_curve(scene: Scene, trajectory: Trajectory) -> ContactForceCur
         float(np.max(x) - origin))
 
 
+PIN_FILE = "C60/FC/Tbar_FC_measurement.stp"
+LAMAGE_AXIS_FILE = "C60/newFC/tbarassembly_asm_axis_lamage.stp"
+
+
+def pin_lamage_distance() -> tuple[float, float, float]:
+    """The tripping bar's pin axis and lamage axis (the features of FC-2/FC-3 and FC-4/FC-5,
+    two points of one rigid body): their distance in the xy plane and along z in the ON pose
+    (the bar's z axis is world z there) [mm], and the xy distance between the paper's mean
+    points (FC-2, FC-3) and (FC-4, FC-5) [mm]. The FC outputs take the pin at its middle and
+    the lamage axis at its middle (:func:`clearbench.scenarios.c60.model.c60_outputs`)."""
+    primitives = model.primitives()
+    rod = primitives[PIN_FILE].primitives[0]
+    pin = np.asarray(rod.axis_point) + 0.5 * rod.length * np.asarray(rod.axis)
+    segment = primitives[LAMAGE_AXIS_FILE].primitives[0]
+    lamage = 0.5 * (np.asarray(segment.start) + np.asarray(segment.end))
+    fcs = {k: v["mean"] for k, v in model.load_model()["paper"]["functional_conditions"].items()}
+    return (float(np.hypot(*(pin - lamage)[:2])), float(abs((pin - lamage)[2])),
+            float(np.hypot(fcs["FC2"] - fcs["FC4"], fcs["FC3"] - fcs["FC5"])))
+
+
+def tilt(orientation: np.ndarray) -> float:
+    """Angle between a body's z axis and world z [rad] (orientation: unit quaternion w, x,
+    y, z)."""
+    w, x, y, _ = orientation / np.linalg.norm(orientation)
+    return float(np.arccos(np.clip(1.0 - 2.0 * (x * x + y * y), -1.0, 1.0)))
+
+
+def pin_lamage_cause(largest_tilt: float | None = None) -> str:
+    """Why FC-2..FC-5 cannot all match the paper's means for any variant of the model
+    (``largest_tilt``: the largest tilt of the tripping bar measured in the runs [rad])."""
+    ours, height, paper = pin_lamage_distance()
+    needed = math.asin(min(1.0, (paper - ours) / height))
+    measured = ("" if largest_tilt is None else
+                f"; the runs of the identification study tilt it by at most "
+                f"{math.degrees(largest_tilt):.2f} deg")
+    return (f"FC-2..FC-5 are the x and y of two points of the rigid tripping bar, its pin "
+            f"and its lamage axis, {ours:.3f} mm apart in the xy plane and {height:.2f} mm "
+            f"apart along z in the CAD; the paper's means put them {paper:.3f} mm apart in "
+            f"xy (the mean of a difference is the difference of the means, so this holds for "
+            f"the Monte Carlo means as for one run). Only a tilt of the bar out of the plane "
+            f"changes that distance, by at most {height:.2f} mm x sin(tilt): "
+            f"{paper:.3f} mm needs a tilt of {math.degrees(needed):.1f} deg{measured}. So "
+            f"for any variant of this model at least one of the paper's FC-2..FC-5 is not "
+            f"the measurement the source's pairs make.")
+
+
 def _patch_ranges() -> dict[tuple[str, str], tuple[float, float]]:
     """(body, shape) -> angular range of the convex cylinder patches the scene models as full
     cylinders (their own frame: angle from x about z, as :class:`~.shapes.Arc`)."""

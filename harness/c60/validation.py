@@ -8,26 +8,20 @@ trajectory file keyed by the scene's content hash), computes the figures and ret
 
 from __future__ import annotations
 
-import functools
 import json
 import logging
 import math
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-import clearbench
-from clearbench.adapters.base import RunSettings
-from clearbench.adapters.reference import create
-from clearbench.adapters.trajectory import Trajectory
-from clearbench.harness.c60 import analysis
+from clearbench.harness.c60 import analysis, identification
+from clearbench.harness.c60.runs import PHYSICS_CODE, Run, run_scene  # noqa: F401 (re-exported)
 from clearbench.harness.measure import series as metrics
 from clearbench.kernels.quaternion import quat_to_matrix
 from clearbench.ref_solver.forces import twist_angle
 from clearbench.scenarios.c60 import model
-from clearbench.scenarios.library import get_scene
 from clearbench.scenarios.scene import Scene
 
 logger = logging.getLogger(__name__)
@@ -40,55 +34,6 @@ EXPLAIN_ABOVE = 0.10
 SPEED_FORCE_TOLERANCE = 0.02
 SPEED_DISTANCE_TOLERANCE = 0.01
 
-
-@dataclass(frozen=True)
-class Run:
-    """One cached run: the scene, its trajectory, and how long stepping took [s]."""
-
-    key: str
-    scene: Scene
-    trajectory: Trajectory
-
-    @property
-    def unconverged(self) -> list:
-        return list(self.trajectory.metadata.get("unconverged_steps", []))
-
-    @functools.cached_property
-    def penetration(self) -> float:
-        """Largest contact penetration over the recorded states [mm] (computed once)."""
-        depth = metrics.penetration(self.scene, self.trajectory)
-        return float(depth.max()) if depth.size else 0.0
-
-
-def run_scene(key: str, name: str, parameters: dict, cache: Path | None, preset: str = "default",
-              record_every: int = 10) -> Run:
-    """Run a registered scene with the reference engine, or read it back from ``cache``: a
-    cached run is reused when its scene, preset and physics code (the sources of the scenes,
-    the solver and the adapters, :data:`PHYSICS_CODE`) are this run's."""
-    scene = get_scene(name, **parameters)
-    code = clearbench.source_digest(PHYSICS_CODE)
-    path = cache / f"{key}.npz" if cache is not None else None
-    if path is not None and path.exists():
-        trajectory = Trajectory.load(path)
-        if (trajectory.scene_hash == scene.content_hash and trajectory.preset == preset
-                and trajectory.metadata.get("physics_code") == code):
-            logger.info("%s: read from %s", key, path)
-            return Run(key, scene, trajectory)
-    logger.info("%s: running %s %s (%s steps)", key, name, parameters,
-                round(scene.horizon / scene.time_step))
-    tick = time.perf_counter()
-    trajectory = create(preset).run(scene, RunSettings(record_every=record_every))
-    logger.info("%s: %.0f s", key, time.perf_counter() - tick)
-    trajectory.metadata["physics_code"] = code
-    if path is not None:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        trajectory.save(path)
-    return Run(key, scene, trajectory)
-
-
-#: The subpackages whose sources decide a cached run's trajectory.
-PHYSICS_CODE = ("clearbench.kernels", "clearbench.scenarios", "clearbench.ref_solver",
-                "clearbench.adapters")
 
 #: Largest contact penetration the C-60 runs may show [mm] (the issue's limit); a run beyond
 #: it is a finding of the report.
@@ -119,10 +64,45 @@ class ValidationReport:
     runs: dict[str, Run] = field(default_factory=dict)
     curves: dict = field(default_factory=dict)
     findings: list[str] = field(default_factory=list)
+    causes: tuple = ()   # (row prefix, cause) measured by this run; DIFFERENCE_CAUSES if empty
 
 
 def _paper() -> dict:
     return model.load_model()["paper"]
+
+
+#: Variants of the identification study whose figures the validation shows beside the
+#: source's model and uses for the measured causes of its differences (runs shared with
+#: ``clearbench c60 identify`` through the cache).
+SENSITIVITY_VARIANTS = identification.candidates("preload-0.9599", "paper-table-4",
+                                                 "latch-0.1")
+
+
+def _variant_rows(study: identification.Identification, report: ValidationReport) -> None:
+    """Rows of the paper's figures for each variant of ``study`` (marked: not the model)."""
+    experiments = _paper()["experiments"]
+    fcs = _paper()["functional_conditions"]
+    force = experiments["contact_force_at_equilibrium_N"]
+    peak = experiments["trip_test_peak_force_N"]
+    distance = experiments["trip_test_total_distance_mm"]
+    for figures in study.figures:
+        note = f"variant {figures.candidate.variant}: {figures.label}; not the model"
+        report.rows.append(Row("FC-1, prototype clearances", "N", figures.fc1_prototype,
+                               force["simulated"], force["measured"], note=note))
+        report.rows.append(Row(f"FC-1, clearances {identification.MEAN_CLEARANCE} mm vs "
+                               "Monte Carlo mean", "N", figures.fc_mean["FC-1"],
+                               fcs["FC1"]["mean"], note=note))
+        report.rows.append(Row(f"FC-6, clearances {identification.MEAN_CLEARANCE} mm vs "
+                               "Monte Carlo mean", "mm", figures.fc_mean["FC-6"],
+                               fcs["FC6"]["mean"], note=note))
+        if figures.trip_curve is not None:
+            report.curves.setdefault("trip_force", {})[figures.candidate.variant] = \
+                figures.trip_curve
+            report.rows.append(Row("Trip test: peak force", "N", figures.trip_peak,
+                                   peak["simulated"], peak["measured"], note=note))
+            report.rows.append(Row("Trip test: total trip distance", "mm",
+                                   figures.trip_distance, distance["simulated"],
+                                   distance["measured"], note=note))
 
 
 def validate(cache: Path | None = None, preset: str = "default", speed_check: bool = True,
@@ -157,18 +137,6 @@ def validate(cache: Path | None = None, preset: str = "default", speed_check: bo
         report.rows.append(Row(f"{fc}, {output} (c60-on, nominal) vs Monte Carlo mean", "mm",
                                settled[output], fcs[key]["mean"],
                                note=f"sigma {fcs[key]['sigma']} mm; {description}"))
-    if sensitivity:
-        for key, parameters, label in (
-                ("on_design_arm", {"handle_spring_arm": "design"},
-                 "handle spring at its design arm"),
-                ("on_preload_0.9599", {"contact_spring_preload": 0.9599},
-                 "contact spring preload 0.9599 rad (the source's commented alternative)")):
-            variant = run(key, "c60-on", parameters)
-            value = analysis.settled_outputs(variant.scene, variant.trajectory)
-            report.rows.append(Row(f"FC-1 with {label}, nominal clearances", "N",
-                                   value["FC1_contact_force"], fcs["FC1"]["mean"],
-                                   note="sensitivity, not the model"))
-
     # The magnetic trip.
     trip = run("trip", "c60-trip", {})
     events = analysis.trip_events(trip.scene, trip.trajectory)
@@ -195,15 +163,6 @@ def validate(cache: Path | None = None, preset: str = "default", speed_check: bo
         report.rows.append(Row("Contact-force test: loaded travel to the reference", "mm",
                                curve.loaded_travel,
                                paper_measured=experiments["contact_test_total_displacement_mm"]))
-    if sensitivity and contact_ok:
-        preload = run("contact_force_test_preload_0.9599", "c60-contact-force-test",
-                      {"contact_spring_preload": 0.9599}, record_every=20)
-        preload_curve = analysis.contact_force_curve(preload.scene, preload.trajectory)
-        report.curves["contact_force"]["preload 0.9599 rad"] = preload_curve
-        report.rows.append(Row("Contact-force test: force at the reference, contact spring "
-                               "preload 0.9599 rad", "N", preload_curve.equilibrium_force,
-                               force["simulated"], force["measured"],
-                               note="sensitivity, not the model"))
     # Bench: tripping force vs displacement (prototype clearances).
     trip_test = run("trip_force_test", "c60-trip-force-test", {}, record_every=20)
     trip_curve = analysis.trip_force_curve(trip_test.scene, trip_test.trajectory)
@@ -219,26 +178,10 @@ def validate(cache: Path | None = None, preset: str = "default", speed_check: bo
                            distance["simulated"], distance["measured"]))
     report.findings.append(_first_contact_phase(trip_test))
     if sensitivity:
-        design = run("trip_force_test_design_arm", "c60-trip-force-test",
-                     {"handle_spring_arm": "design"}, record_every=20)
-        design_curve = analysis.trip_force_curve(design.scene, design.trajectory)
-        report.curves["trip_force"]["design arm"] = design_curve
-        report.rows.append(Row("Trip test: peak force, handle spring at its design arm", "N",
-                               design_curve.peak_force, peak["simulated"], peak["measured"],
-                               note="sensitivity, not the model"))
-        report.rows.append(Row("Trip test: trip distance, handle spring at its design arm",
-                               "mm", design_curve.trip_distance, distance["simulated"],
-                               distance["measured"], note="sensitivity, not the model"))
-        preload = run("trip_force_test_preload_0.9599", "c60-trip-force-test",
-                      {"contact_spring_preload": 0.9599}, record_every=20)
-        preload_curve = analysis.trip_force_curve(preload.scene, preload.trajectory)
-        report.curves["trip_force"]["preload 0.9599 rad"] = preload_curve
-        report.rows.append(Row("Trip test: peak force, contact spring preload 0.9599 rad", "N",
-                               preload_curve.peak_force, peak["simulated"], peak["measured"],
-                               note="sensitivity, not the model"))
-        report.rows.append(Row("Trip test: trip distance, contact spring preload 0.9599 rad",
-                               "mm", preload_curve.trip_distance, distance["simulated"],
-                               distance["measured"], note="sensitivity, not the model"))
+        study = identification.identify(cache, preset, SENSITIVITY_VARIANTS)
+        report.runs.update(study.runs)
+        _variant_rows(study, report)
+        report.causes = measured_causes(study)
     report.findings.append(explain_contact_force(nominal))
     if speed_check:
         base_speed = _probe_speed(trip_test.scene)
@@ -408,37 +351,63 @@ MODEL_NOTES = (
 )
 
 
-#: What we believe causes a difference above 10 % from the paper, by the start of the row's
-#: quantity. A belief, stated as such: none of these has been confirmed by a run that removes the
-#: cause.
+#: What causes a difference above 10 % from the paper, by the start of the row's quantity, when
+#: the validation ran without the variants (``--no-sensitivity``); with them,
+#: :func:`measured_causes` states the same causes with the figures the variants measured.
 DIFFERENCE_CAUSES = (
-    ("FC-1", "the source's contact-pressure law, M = 244.46 (D + 0.49) N mm, balances at C7 "
-     "with about 7.4 N at the levers of the assembled CAD (the moment balance is in the "
-     "findings); about 15 N needs M near 300 N mm, so the paper's model had a stiffer or more "
-     "preloaded contact spring than this version of the source. The contact spring preload is "
-     "the one parameter the source comments as uncertain (0.49, 0.6547 or 0.9599 rad)."),
+    ("FC-1", "the contact-pressure law's preload: M = 244.46 (D + 0.49) N mm balances at C7 "
+     "with about 7.4 N (the moment balance is in the findings); the source's comment "
+     "documents 0.9599 rad, with which FC-1 lands near the paper's (run `clearbench c60 "
+     "validate` without --no-sensitivity, or `clearbench c60 identify`, for the figures)."),
     ("Contact-force test: force at the reference", "the probe stands in for the fixed "
-     "contact, so the force at the reference is FC-1 of this configuration (the same moment "
-     "balance of the source's contact-pressure law, see the FC-1 rows); the loaded travel, "
-     "which depends on the geometry, agrees with the measured 2.0 mm."),
-    ("FC-", "one run at the nominal clearances compared with the mean of the paper's Monte "
-     "Carlo over manufacturing tolerances, and measurement pairs whose names pair oddly with "
-     "the paper's FC definitions (see the functional conditions above): the x distances agree "
-     "within 1.2 %, the y distances do not, which points at the pairs' y reference, not at "
-     "the dynamics."),
-    ("Trip test: peak force", "the force needed to pull the tripping-bar pin is set by the "
-     "latch load (C4, C5) times its friction, and the latch load by the handle and contact "
-     "springs; with the source's handle-spring arm (21 mm from the pivot instead of the law's "
-     "design arm, see the model notes) and its contact law (FC-1 above is half the paper's), "
-     "the latch of this model is loaded differently from the paper's. The displacement at the "
-     "peak and the trip distance, which depend on the latch geometry rather than on its load, "
-     "agree within 9 %."),
+     "contact, so the force at the reference is FC-1 of this configuration (see FC-1)."),
+    ("FC-", analysis.pin_lamage_cause()),
+    ("Trip test: peak force", "the latch friction: the source gives the four hook/tripping-"
+     "bar latch pairs C4 mu 0.2, which is neither of the paper's Table 4 values (0.1 "
+     "metal/plastic, 0.3 plastic/plastic); the peak scales with it (variant latch-0.1: run "
+     "`clearbench c60 identify` for the figures)."),
 )
 
 
-def difference_cause(quantity: str) -> str:
-    """What we believe causes the difference of the row ``quantity`` (see DIFFERENCE_CAUSES)."""
-    for prefix, cause in DIFFERENCE_CAUSES:
+def measured_causes(study: identification.Identification) -> tuple:
+    """DIFFERENCE_CAUSES with the figures the study's variants measured."""
+    by_name = {f.candidate.variant: f for f in study.figures}
+    preload = by_name["preload-0.9599"]
+    latch = by_name["latch-0.1"]
+    table_4 = by_name["paper-table-4"]
+    experiments = _paper()["experiments"]
+    fcs = _paper()["functional_conditions"]
+    fc1 = (f"the contact-pressure law's preload: M = 244.46 (D + 0.49) N mm balances at C7 "
+           f"with about 7.4 N (the moment balance is in the findings). With the preload the "
+           f"source's comment documents, 0.9599 rad (variant preload-0.9599, measured): FC-1 "
+           f"{preload.fc1_prototype:.2f} N at the prototype's clearances (paper "
+           f"{experiments['contact_force_at_equilibrium_N']['simulated']} N simulated, "
+           f"{experiments['contact_force_at_equilibrium_N']['measured']} N measured) and "
+           f"{preload.fc_mean['FC-1']:.2f} N with every joint at "
+           f"{identification.MEAN_CLEARANCE} mm (paper's Monte Carlo mean "
+           f"{fcs['FC1']['mean']} N), FC-6 {preload.fc_mean['FC-6']:.3f} mm (paper "
+           f"{fcs['FC6']['mean']} mm). The full table: `clearbench c60 identify`.")
+    trip = (f"the latch friction, measured: the source gives the four hook/tripping-bar latch "
+            f"pairs C4 mu 0.2, neither of the paper's Table 4 values. With mu_C4 = 0.1 "
+            f"(variant latch-0.1) the peak is {latch.trip_peak:.2f} N at "
+            f"{latch.trip_peak_at:.3f} mm and the trip distance {latch.trip_distance:.3f} mm "
+            f"(paper: {experiments['trip_test_peak_force_N']['simulated']} N simulated, "
+            f"{experiments['trip_test_peak_force_N']['measured']} N measured at "
+            f"{experiments['trip_test_peak_at_mm']} mm; "
+            f"{experiments['trip_test_total_distance_mm']['simulated']} / "
+            f"{experiments['trip_test_total_distance_mm']['measured']} mm). The paper's Table 4 "
+            f"by materials puts C4 at 0.3 (hook and tripping bar are both plastic, variant "
+            f"paper-table-4): peak {table_4.trip_peak:.2f} N. The preload that moves FC-1 onto "
+            f"the paper's loads the latch more: preload 0.9599 rad gives "
+            f"{preload.trip_peak:.2f} N.")
+    return (("FC-1", fc1), DIFFERENCE_CAUSES[1], DIFFERENCE_CAUSES[2],
+            ("Trip test: peak force", trip))
+
+
+def difference_cause(quantity: str, causes: tuple = ()) -> str:
+    """What causes the difference of the row ``quantity`` (``causes``, else
+    DIFFERENCE_CAUSES)."""
+    for prefix, cause in causes or DIFFERENCE_CAUSES:
         if quantity.startswith(prefix):
             return cause
     return "not analysed."
@@ -482,11 +451,11 @@ def write_markdown(report: ValidationReport, path: Path, figures: dict[str, Path
     lines += ["", "## Findings", ""]
     lines += [f"- {finding}" for finding in report.findings]
     large = [row for row in report.rows if not math.isnan(row.difference())
-             and abs(row.difference()) > EXPLAIN_ABOVE and "sensitivity" not in row.note]
+             and abs(row.difference()) > EXPLAIN_ABOVE and "not the model" not in row.note]
     if large:
         lines += ["", "## Differences above 10 %", ""]
         lines += [f"- {row.quantity}: {100 * row.difference():+.1f} %. What we believe causes "
-                  f"it: {difference_cause(row.quantity)}" for row in large]
+                  f"it: {difference_cause(row.quantity, report.causes)}" for row in large]
     lines += ["", "## Runs", "",
               "| run | scene | status | steps | stepping [s] | unconverged steps | "
               "max penetration [mm] |",
@@ -529,7 +498,7 @@ def write_json(report: ValidationReport, path: Path, figures: dict[str, Path],
                   "paper_simulated": _number(row.paper_simulated),
                   "paper_measured": _number(row.paper_measured),
                   "difference": _number(row.difference()), "note": row.note,
-                  "believed_cause": difference_cause(row.quantity)
+                  "believed_cause": difference_cause(row.quantity, report.causes)
                   if abs(_number(row.difference()) or 0.0) > EXPLAIN_ABOVE else None}
                  for row in report.rows],
         "findings": list(report.findings),

@@ -6,6 +6,9 @@
 - ``clearbench c60 compare [--plan demo|full]``: c60-on and c60-trip in every available engine
   and preset over a ladder of steps (the plans of :mod:`clearbench.harness.studies.c60_comparison`),
   the cross-engine table and the work-precision summary printed, then the report written.
+- ``clearbench c60 identify``: the identification study (which of the source's documented
+  alternatives reproduces which section of the paper), one table in
+  ``reports/c60_identification.md``.
 - ``clearbench c60 angles TRAJECTORY.npz``: each body's angle about z and the largest body
   speed along a run (a diagnostic, for example of a cached run).
 """
@@ -14,10 +17,12 @@ from __future__ import annotations
 
 import argparse
 import math
+from dataclasses import replace
 from pathlib import Path
 
 from clearbench.adapters.reference import ReferenceEngine
 from clearbench.adapters.trajectory import Trajectory
+from clearbench.harness.c60 import identification
 from clearbench.harness.c60.angles import body_angles
 from clearbench.harness.c60.cross_engine import collect
 from clearbench.harness.c60.validation import validate, write_figures, write_json, write_markdown
@@ -37,6 +42,7 @@ from clearbench.harness.studies.c60_comparison import PLANS, plan_engines, plan_
 DEFAULT_REPORT = Path("reports/c60_validation.md")
 DEFAULT_FIGURES = Path("reports/figures")
 DEFAULT_CACHE = Path(".cache/c60")
+DEFAULT_IDENTIFICATION = Path("reports/c60_identification.md")
 
 
 def register(subparsers) -> None:
@@ -56,17 +62,14 @@ def register(subparsers) -> None:
         "takes tens of minutes of stepping on one core; cached runs are reused when the "
         "scene, the preset and the physics code (scenes, solver, adapters) are unchanged.",
     )
-    validate.add_argument("--out", type=Path, default=DEFAULT_REPORT,
-                          help=f"Markdown report (default {DEFAULT_REPORT})")
+    _add_run_options(validate, DEFAULT_REPORT, "Markdown report")
     validate.add_argument("--figures", type=Path, default=DEFAULT_FIGURES,
                           help=f"directory of the PNG figures (default {DEFAULT_FIGURES})")
-    validate.add_argument("--cache", type=Path, default=DEFAULT_CACHE,
-                          help=f"directory of cached trajectories (default {DEFAULT_CACHE})")
-    validate.add_argument("--preset", default="default", help="reference engine preset")
     validate.add_argument("--no-speed-check", action="store_true",
                           help="skip the half-speed reruns of the bench tests")
     validate.add_argument("--no-sensitivity", action="store_true",
-                          help="skip the sensitivity runs (design arm, alternative preload)")
+                          help="skip the variants' runs (preload 0.9599 rad, the paper's Table 4 "
+                          "friction, mu_C4 0.1; shared with `clearbench c60 identify`)")
     validate.set_defaults(handler=run_validate)
     compare = commands.add_parser(
         "compare", help="c60-on and c60-trip across engines, work-precision, report",
@@ -86,6 +89,26 @@ def register(subparsers) -> None:
                          help="report directory (default reports/out)")
     add_runner_options(compare, timeout=7200.0)
     compare.set_defaults(handler=run_c60_compare)
+    identify = commands.add_parser(
+        "identify", help="which documented variant of the model reproduces which paper figure",
+        description="Run (or read from the cache) c60-on at the paper's mean clearances and "
+        "at the prototype's, and the bench tests, for the source's documented alternatives "
+        "and their combinations; write one table of every published figure per variant with "
+        "the sections each matches. About 30 c60-on runs of 4 ms and 6 bench tests: tens of "
+        "minutes on one core the first time, seconds from the cache.",
+    )
+    _add_run_options(identify, DEFAULT_IDENTIFICATION, "Markdown table (JSON beside it)")
+    identify.add_argument("--variants", metavar="NAME,...",
+                          help="only these variants of the study (default: all of them)")
+    identify.add_argument("--runs", choices=("all", "on", "bench"), default="all",
+                          help="all (default), only the c60-on runs, or only the bench tests "
+                          "(two processes can share the cache without running a case twice)")
+    identify.add_argument("--no-calibration", action="store_true",
+                          help="skip the labelled calibration (the preload fitted to the "
+                          "prototype's FC-1, judged on the other figures)")
+    identify.add_argument("--cached-only", action="store_true",
+                          help="write the table from the cached runs only, running nothing")
+    identify.set_defaults(handler=run_identify)
     angles = commands.add_parser(
         "angles", help="each body's angle about z and the largest speed along a trajectory",
         description="For a trajectory written by the reference engine (for example the cache "
@@ -99,11 +122,23 @@ def register(subparsers) -> None:
     angles.set_defaults(handler=run_angles)
 
 
-def run_validate(args: argparse.Namespace) -> int:
+def _add_run_options(parser, report: Path, what: str) -> None:
+    """--out, --cache and --preset of the commands that run the C-60 scenes."""
+    parser.add_argument("--out", type=Path, default=report, help=f"{what} (default {report})")
+    parser.add_argument("--cache", type=Path, default=DEFAULT_CACHE,
+                        help=f"directory of cached trajectories (default {DEFAULT_CACHE})")
+    parser.add_argument("--preset", default="default", help="reference engine preset")
+
+
+def _check_preset(preset: str) -> None:
     try:
-        ReferenceEngine(args.preset)   # the engine's own preset check, before any run
+        ReferenceEngine(preset)   # the engine's own preset check, before any run
     except ValueError as error:
         raise UserError(str(error)) from None
+
+
+def run_validate(args: argparse.Namespace) -> int:
+    _check_preset(args.preset)
     report = validate(cache=args.cache, preset=args.preset,
                       speed_check=not args.no_speed_check,
                       sensitivity=not args.no_sensitivity)
@@ -121,6 +156,33 @@ def run_validate(args: argparse.Namespace) -> int:
     print(f"report: {args.out} (and {args.out.with_suffix('.json')} for `clearbench report`)")
     for path in figures.values():
         print(f"figure: {path}")
+    return 0
+
+
+def run_identify(args: argparse.Namespace) -> int:
+    _check_preset(args.preset)
+    candidates = identification.CANDIDATES
+    if args.variants:
+        wanted = [name.strip() for name in args.variants.split(",") if name.strip()]
+        known = {c.name: c for c in candidates}
+        unknown = [name for name in wanted if name not in known]
+        if unknown or not wanted:
+            raise UserError(f"--variants {args.variants}: unknown {unknown}; the study's "
+                            f"variants: {', '.join(known)}")
+        candidates = tuple(known[name] for name in wanted)
+    if args.runs == "on":
+        candidates = tuple(replace(c, trip_test=False, contact_test=False) for c in candidates)
+    elif args.runs == "bench":
+        candidates = tuple(replace(c, on=False) for c in candidates)
+    study = identification.identify(args.cache, args.preset, candidates,
+                                    progress=lambda key: print(f"run {key}", flush=True),
+                                    cached_only=args.cached_only,
+                                    calibrate=not args.no_calibration)
+    lines = identification.table_lines(study)
+    print("\n".join(lines))
+    identification.write_markdown(study, args.out, args.preset, identification.ON_HORIZON)
+    identification.write_json(study, args.out.with_suffix(".json"))
+    print(f"report: {args.out} (and {args.out.with_suffix('.json')})")
     return 0
 
 

@@ -22,6 +22,7 @@ import numpy as np
 
 from clearbench.scenarios.bodies import Body, Motion
 from clearbench.scenarios.c60 import model
+from clearbench.scenarios.c60.variants import ModelParameters
 from clearbench.scenarios.contacts import ContactPair
 from clearbench.scenarios.drivers import Driver
 from clearbench.scenarios.expectations import Expectation
@@ -67,8 +68,7 @@ def contact_force_test_scene(
     retreat_speed: float = 0.5,
     hold: float = 2.0,
     time_step: float = 1e-3,
-    handle_spring_arm: str = "design",
-    contact_spring_preload: float = model.CONTACT_SPRING_PRELOAD,
+    parameters: ModelParameters | None = None,
 ) -> Scene:
     """Section 5.2: probe in place of the fixed contact, forward to the reference and back.
 
@@ -87,7 +87,8 @@ def contact_force_test_scene(
     over 2.0 mm) and then rests on C6; ``stroke`` (2.2 mm) only just exceeds that, so that the
     curve reaches zero load while the unloaded time stays short (2.4 ms at the default speeds).
 
-    The handle spring acts at its design arm by default here (10 N mm about the handle's pivot
+    The library scene ``c60-contact-force-test`` puts the handle spring at its design arm
+    unless told otherwise (10 N mm about the handle's pivot
     instead of the source's 27, see :mod:`.c60_model`). Measured with the reference engine
     over the first 10 ms (``clearbench c60 angles`` on the trajectory): with the
     source's arm the handle leaves its ON pose within 1 ms of the moving contact landing on
@@ -106,6 +107,8 @@ def contact_force_test_scene(
         Probe speed of the set-up retreat [mm/ms].
     hold : float
         Time at the reference position [ms].
+    parameters : ModelParameters, optional
+        The model's documented alternatives (:mod:`.variants`); the source's by default.
     """
     clearances = model.prototype_clearances() if clearances is None else clearances
     frame_face = next(s for s in model.c60_scene().body(model.FRAME).shapes
@@ -124,7 +127,7 @@ def contact_force_test_scene(
                           offset=float(c7["offset"]))
     return model.c60_scene(
         name, clearances=clearances, horizon=times[-1] + 0.2, time_step=time_step,
-        handle_spring_arm=handle_spring_arm, contact_spring_preload=contact_spring_preload,
+        parameters=parameters,
         without_contacts=(model.C7,),
         extra_bodies=(probe,), extra_contacts=(contact,),
         extra_drivers=_probe_drivers("x", times, values, "position"),
@@ -158,8 +161,7 @@ def trip_force_test_scene(
     approach_speed: float = 0.1,
     stroke: float = 0.65,
     time_step: float = 1e-3,
-    handle_spring_arm: str = "source",
-    contact_spring_preload: float = model.CONTACT_SPRING_PRELOAD,
+    parameters: ModelParameters | None = None,
 ) -> Scene:
     """Section 5.3, pin side: a spherical probe pushes the tripping bar's pin along world +y.
 
@@ -187,6 +189,8 @@ def trip_force_test_scene(
         turns into poses its contact set does not cover (measured with a 0.9 mm stroke at half
         the probe speed: projections failing from 11.6 ms after the release, a 0.8 mm
         penetration, the bodies tumbling).
+    parameters : ModelParameters, optional
+        The model's documented alternatives (:mod:`.variants`); the source's by default.
     """
     clearances = model.prototype_clearances() if clearances is None else clearances
     pin = pin_shape()
@@ -201,7 +205,7 @@ def trip_force_test_scene(
     horizon = slow_from + stroke / probe_speed
     return model.c60_scene(
         name, clearances=clearances, horizon=horizon, time_step=time_step,
-        handle_spring_arm=handle_spring_arm, contact_spring_preload=contact_spring_preload,
+        parameters=parameters,
         extra_shapes={"tripping_bar": (pin,)},
         extra_bodies=(probe,), extra_contacts=(contact,),
         extra_drivers=_probe_drivers(

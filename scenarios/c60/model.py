@@ -13,7 +13,8 @@ the paper's mass and inertia (0.39 g, diag(8.5112, 0.19729, 8.5611) g mm^2; the 
 and identity inertia are placeholders).
 
 Contacts. Each of the 39 contact pairs of the sheet, body1 = A (the offset is taken on A's side,
-as the source does), each CAD surface reduced to a shape:
+as the source does; friction the sheet's or as :mod:`.variants` says), each CAD surface
+reduced to a shape:
 
 * bearing ring (a band 0.005-0.02 mm wide) -> :class:`~.shapes.Circle` at the middle of the band;
 * convex cylinder or cylinder patch (journals, the C5, C7 and FC_X patches, the C4 fillet) ->
@@ -54,10 +55,11 @@ plugin functions being registered as internal forces that Siconos subtracts):
 * ``contact_pressure_spring``: angle law M = 244.46 (theta_mc - theta_plate + (54.54 + 22) deg +
   0.49 rad) N mm, applied as a force M / 5.48 along plate body (-1.1, 0.9, 0) at its centre of
   mass, a moment 0.2513 M about world z on the plate, and a force M / 6.06 along moving-contact
-  body (0.6, -1.1, -0.01) at its centre of mass. The source's comment lists 0.6547 and 0.9599
-  rad as other preloads (``contact_spring_preload``); with 0.9599 FC-1 is 13.1 N and FC-6
-  0.658 mm, where the paper's Monte Carlo means are 13.66 N and 0.659 mm (0.49: 7.35 N,
-  0.511 mm).
+  body (0.6, -1.1, -0.01) at its centre of mass. The source's comments document other
+  preloads, offsets and levers: :mod:`.variants` makes each a named, validated parameter
+  (``contact_spring_preload``, ``contact_spring_angle_offset``, ``moving_contact_force_lever``,
+  ``plate_force_lever``) and ``clearbench c60 identify`` measures what each does to the paper's
+  figures.
 * ``tripping_bar_moment``: a moment on the tripping bar about world z for t < 1 ms. The source's
   function returns +15 N mm, registered as an internal moment, i.e. the physical moment is
   -15 N mm (it presses the bar toward its stop, away from tripping).
@@ -85,6 +87,7 @@ import numpy as np
 from clearbench.kernels.quaternion import quat_from_axis_angle, quat_from_matrix, quat_to_matrix
 from clearbench.scenarios.bodies import Body, Motion
 from clearbench.scenarios.c60 import primitives as prim
+from clearbench.scenarios.c60.variants import ModelParameters, contact_friction
 from clearbench.scenarios.contacts import ContactPair
 from clearbench.scenarios.drivers import Driver
 from clearbench.scenarios.expectations import Expectation
@@ -365,11 +368,14 @@ def radial_clearances(scene: Scene) -> dict[str, float]:
 # ------------------------------------------------------------------------------------------------
 
 
-def _contact_geometry(offsets: Mapping[str, float], poses: Mapping[str, Pose]):
-    """Shapes per body and the contact pairs, from the sheet's contacts."""
+def _contact_geometry(offsets: Mapping[str, float], poses: Mapping[str, Pose],
+                      parameters: ModelParameters):
+    """Shapes per body and the contact pairs, from the sheet's contacts (friction per
+    ``parameters``)."""
     shapes: dict[str, dict[str, Shape]] = {name: {} for name in poses}
     pairs: list[ContactPair] = []
     for contact in load_model()["contacts"]:
+        friction = contact_friction(contact, parameters, _file_stem)
         side_shapes = []
         for side, other in (("1", "2"), ("2", "1")):
             body = contact[f"body{side}"]
@@ -397,7 +403,7 @@ def _contact_geometry(offsets: Mapping[str, float], poses: Mapping[str, Pose]):
                 pairs.append(ContactPair(
                     contact["name"] + (f"_{label}" if label else ""),
                     body_a=contact["body1"], shape_a=shape_a, body_b=contact["body2"],
-                    shape_b=shape_b, friction=float(contact["friction"]),
+                    shape_b=shape_b, friction=friction,
                     restitution=float(contact["restitution"]),
                     offset=offsets[contact["name"]]))
     return shapes, pairs
@@ -455,14 +461,11 @@ def _unsigned_initial_angle(body: str) -> float:
     return abs(float(_body_entry(body)["rotation_angle"]))
 
 
-#: Preload term of the contact-pressure law in the source [rad] (its comment lists 0.6547 and
-#: 0.9599 as other values).
-CONTACT_SPRING_PRELOAD = 0.49
-
-
-def c60_loads(handle_spring_arm: str = "source", bar_moment_sign: float = -1.0,
-              contact_spring_preload: float = CONTACT_SPRING_PRELOAD) -> list:
-    """The 4 loads of the sheet as scene loads (see the module docstring)."""
+def c60_loads(parameters: ModelParameters | None = None, bar_moment_sign: float = -1.0) -> list:
+    """The 4 loads of the sheet as scene loads (see the module docstring), with the
+    contact-pressure law's preload, offset and levers and the handle spring's arm from
+    ``parameters`` (the source's by default, see :mod:`.variants`)."""
+    parameters = parameters or ModelParameters()
     sheet = {item["name"]: item for item in load_model()["loads"]}
     handle = sheet["handle_spring"]
     a2 = sheet["plate_spring_A2"]
@@ -478,7 +481,7 @@ def c60_loads(handle_spring_arm: str = "source", bar_moment_sign: float = -1.0,
             angle_bodies=("handle",), angle_coefficients=(-1.0,),
             applications=(LoadApplication(
                 "handle", "force", tuple(handle["force_direction_body"]), "body",
-                handle_spring_point(handle_spring_arm), lever=lever),),
+                handle_spring_point(parameters.handle_spring_arm), lever=lever),),
         ),
         DistanceLawLoad(
             "plate_spring_A2", body_a=FRAME, point_a=tuple(a2["frame_point"]), body_b="plate",
@@ -489,14 +492,15 @@ def c60_loads(handle_spring_arm: str = "source", bar_moment_sign: float = -1.0,
         ),
         AngleLawLoad(
             "contact_pressure_spring", axis=Z_AXIS, stiffness=float(contact["stiffness"]),
-            offset=math.radians(54.54 + 22.0) + contact_spring_preload,
+            offset=(math.radians(-parameters.contact_spring_angle_offset)
+                    + parameters.contact_spring_preload),
             angle_bodies=("moving_contact", "plate"), angle_coefficients=(1.0, -1.0),
             applications=(
                 LoadApplication("plate", "force", (-1.1, 0.9, 0.0), "body", plate_centre,
-                                lever=5.48),
+                                lever=parameters.plate_force_lever),
                 LoadApplication("plate", "moment", Z_AXIS, "world", coefficient=0.2513),
                 LoadApplication("moving_contact", "force", (0.6, -1.1, -0.01), "body",
-                                moving_centre, lever=6.06),
+                                moving_centre, lever=parameters.moving_contact_force_lever),
             ),
         ),
         Moment("tripping_bar_moment", body="tripping_bar",
@@ -588,9 +592,8 @@ def c60_scene(
     plunger_start: float = 0.7,
     horizon: float = 7.0,
     time_step: float = 1e-3,
-    handle_spring_arm: str = "source",
+    parameters: ModelParameters | None = None,
     bar_moment_sign: float = -1.0,
-    contact_spring_preload: float = CONTACT_SPRING_PRELOAD,
     extra_shapes: Mapping[str, tuple[Shape, ...]] | None = None,
     extra_bodies: tuple[Body, ...] = (),
     extra_contacts: tuple[ContactPair, ...] = (),
@@ -613,12 +616,12 @@ def c60_scene(
         Time the plunger starts [ms].
     horizon, time_step : float
         Simulated time and suggested step [ms].
-    handle_spring_arm : str
-        ``source`` (the source's moment, default) or ``design`` (see the module docstring).
+    parameters : ModelParameters, optional
+        The documented alternatives (contact-pressure law, handle-spring arm, friction per
+        contact class, see :mod:`.variants`); the source's model by default. Recorded in the
+        scene's description (so in its content hash).
     bar_moment_sign : float
         Sign of the tripping bar's settling moment about world z (-1: the source's).
-    contact_spring_preload : float
-        Preload term of the contact-pressure law [rad] (0.49: the source's).
     extra_shapes : mapping body -> shapes, optional
         Shapes added to the sheet's bodies (e.g. the tripping-bar pin a probe pushes).
     extra_bodies, extra_contacts, extra_drivers, extra_outputs : tuples
@@ -626,9 +629,10 @@ def c60_scene(
     without_contacts : tuple of str
         Names of sheet contacts to leave out (e.g. C7 when a probe replaces the fixed contact).
     """
+    parameters = parameters or ModelParameters()
     poses = on_poses()
     offsets = contact_offsets(clearances)
-    shapes, pairs = _contact_geometry(offsets, poses)
+    shapes, pairs = _contact_geometry(offsets, poses, parameters)
     for body, added in (extra_shapes or {}).items():
         if body not in shapes:
             raise SceneError("extra_shapes", body, "unknown body")
@@ -645,14 +649,15 @@ def c60_scene(
                if not (isinstance(o, ContactForce) and o.contact in without_contacts)]
     return Scene(
         name=name,
-        description=description or "Schneider Electric C-60 circuit breaker mechanism, ON pose.",
+        description=(description or "Schneider Electric C-60 circuit breaker mechanism, ON "
+                     "pose.") + f" Model: {parameters.label()}.",
         units=MM_G_MS,
         gravity=(0.0, 0.0, 0.0),
         horizon=horizon,
         time_step=time_step,
         bodies=tuple(_bodies(shapes)) + tuple(extra_bodies),
         contacts=tuple(pairs) + tuple(extra_contacts),
-        loads=tuple(c60_loads(handle_spring_arm, bar_moment_sign, contact_spring_preload)),
+        loads=tuple(c60_loads(parameters, bar_moment_sign)),
         drivers=tuple(drivers) + tuple(extra_drivers),
         outputs=tuple(outputs) + tuple(extra_outputs),
         expectations=tuple(expectations) or (Expectation("no_penetration",

@@ -8,9 +8,16 @@
   with the prototype's clearances (Table 7), see :mod:`.c60_bench`.
 
 Every factory takes ``clearances`` (joint -> radial clearance [mm]), ``time_step`` and
-``horizon`` [ms] where it applies, and ``handle_spring_arm`` (see :mod:`.c60_model`; the
-contact-force test takes the design arm by default, see :mod:`.c60_bench`);
-and ``contact_spring_preload`` [rad] (the source's 0.49 by default).
+``horizon`` [ms] where it applies, a named model ``variant`` (``source`` by default; the
+source's documented alternatives, ``paper-table-4`` friction and combinations, see
+:data:`clearbench.scenarios.c60.variants.VARIANTS`) and, as keyword overrides of the
+variant, the fields of :class:`~clearbench.scenarios.c60.variants.ModelParameters`:
+``contact_spring_preload`` [rad], ``contact_spring_angle_offset`` [deg],
+``moving_contact_force_lever`` and ``plate_force_lever`` [mm], ``handle_spring_arm``
+(``source``/``design``; the contact-force test takes ``design`` unless told, see
+:mod:`.c60_bench`), ``friction_set`` (``source``/``paper-table-4``) and ``friction``
+(contact class -> coefficient, e.g. ``friction={"C4": 0.1}``). A bad value is refused naming
+the field before the scene is built.
 """
 
 from __future__ import annotations
@@ -19,6 +26,7 @@ from collections.abc import Mapping
 
 from clearbench.scenarios.c60 import bench as c60_bench
 from clearbench.scenarios.c60 import model as c60_model
+from clearbench.scenarios.c60.variants import model_parameters
 from clearbench.scenarios.expectations import Expectation
 from clearbench.scenarios.registry import register
 from clearbench.scenarios.scene import Scene
@@ -31,12 +39,10 @@ SETTLED_AFTER = 3.0
 @register("c60-on", tags=("c60",),
           summary="C-60 breaker in its ON pose: settles, stays latched; FC-1..FC-6")
 def c60_on(clearances: Mapping[str, float] | None = None, horizon: float = 7.0,
-           time_step: float = 1e-3, handle_spring_arm: str = "source",
-           contact_spring_preload: float = c60_model.CONTACT_SPRING_PRELOAD) -> Scene:
+           time_step: float = 1e-3, variant: str = "source", **model) -> Scene:
     return c60_model.c60_scene(
         "c60-on", clearances=clearances, horizon=horizon, time_step=time_step,
-        handle_spring_arm=handle_spring_arm, plunger_speed=0.0,
-        contact_spring_preload=contact_spring_preload,
+        parameters=model_parameters(variant, **model), plunger_speed=0.0,
         expectations=(
             Expectation("no_penetration", kind="no_penetration"),
             Expectation("stays_latched", kind="sticks", body="hook",
@@ -52,11 +58,11 @@ def c60_on(clearances: Mapping[str, float] | None = None, horizon: float = 7.0,
 @register("c60-trip", tags=("c60",),
           summary="C-60 magnetic trip: the plunger strikes the bar, the latch releases, C7 opens")
 def c60_trip(clearances: Mapping[str, float] | None = None, horizon: float = 20.0,
-             time_step: float = 1e-3, handle_spring_arm: str = "source",
-             plunger_speed: float = 0.2, plunger_start: float = 0.7) -> Scene:
+             time_step: float = 1e-3, plunger_speed: float = 0.2, plunger_start: float = 0.7,
+             variant: str = "source", **model) -> Scene:
     return c60_model.c60_scene(
         "c60-trip", clearances=clearances, horizon=horizon, time_step=time_step,
-        handle_spring_arm=handle_spring_arm, plunger_speed=plunger_speed,
+        parameters=model_parameters(variant, **model), plunger_speed=plunger_speed,
         plunger_start=plunger_start,
         description="Schneider Electric C-60 magnetic trip (the source's 20 ms run): the "
         f"plunger moves at {plunger_speed} mm/ms from {plunger_start} ms, pushes the tripping "
@@ -68,21 +74,18 @@ def c60_trip(clearances: Mapping[str, float] | None = None, horizon: float = 20.
           summary="C-60 bench test: probe in place of the fixed contact, force vs displacement")
 def c60_contact_force_test(clearances: Mapping[str, float] | None = None,
                            probe_speed: float = 0.1, time_step: float = 1e-3,
-                           handle_spring_arm: str = "design",
-                           contact_spring_preload: float = c60_model.CONTACT_SPRING_PRELOAD
-                           ) -> Scene:
+                           variant: str = "source", **model) -> Scene:
+    model.setdefault("handle_spring_arm", "design")
     return c60_bench.contact_force_test_scene(
         clearances=clearances, probe_speed=probe_speed, time_step=time_step,
-        handle_spring_arm=handle_spring_arm, contact_spring_preload=contact_spring_preload)
+        parameters=model_parameters(variant, **model))
 
 
 @register("c60-trip-force-test", tags=("c60", "bench"),
           summary="C-60 bench test: probe pushes the tripping-bar pin until the latch releases")
 def c60_trip_force_test(clearances: Mapping[str, float] | None = None,
                         probe_speed: float = 0.02, time_step: float = 1e-3,
-                        handle_spring_arm: str = "source",
-                        contact_spring_preload: float = c60_model.CONTACT_SPRING_PRELOAD
-                        ) -> Scene:
+                        variant: str = "source", **model) -> Scene:
     return c60_bench.trip_force_test_scene(
         clearances=clearances, probe_speed=probe_speed, time_step=time_step,
-        handle_spring_arm=handle_spring_arm, contact_spring_preload=contact_spring_preload)
+        parameters=model_parameters(variant, **model))
