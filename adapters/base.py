@@ -150,6 +150,10 @@ class Engine(ABC):
     PRESETS: ClassVar[Mapping[str, Mapping]] = {"default": {}}
     #: Names of the options a run may set (``RunSettings.options``).
     OPTION_NAMES: ClassVar[Sequence[str]] = ()
+    #: Whether contacts are rigid (impulses, no contact spring: nonsmooth engines) rather than
+    #: compliant; recorded in each trajectory's metadata as ``rigid_contacts``. A rigid engine
+    #: stores no elastic energy in its contacts (``harness.measure.series.contact_energy``).
+    RIGID_CONTACTS: ClassVar[bool] = False
 
     def __init__(self, preset: str = "default"):
         if preset not in self.PRESETS:
@@ -246,7 +250,9 @@ class Engine(ABC):
         if reasons:
             return Trajectory.empty(self.name, self.preset, scene, RunStatus.UNSUPPORTED,
                                     "; ".join(reasons))
-        return self._run(scene, settings)
+        trajectory = self._run(scene, settings)
+        trajectory.metadata.setdefault("rigid_contacts", self.RIGID_CONTACTS)
+        return trajectory
 
     @abstractmethod
     def _run(self, scene: Scene, settings: RunSettings) -> Trajectory:

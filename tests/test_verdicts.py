@@ -6,6 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from clearbench.adapters import mujoco, reference
+from clearbench.adapters.base import RunSettings
 from clearbench.adapters.trajectory import RunStatus, Trajectory, scene_fields
 from clearbench.harness.measure import series
 from clearbench.harness.measure.figures import measure
@@ -80,3 +82,18 @@ def test_contact_energy_is_half_the_normal_force_times_the_penetration():
     energy = series.contact_energy(scene, trajectory)
     # 0.5 * 10 N * 1e-4 m = 5e-4 J, to round-off of the gap (1e-12 of the lengths).
     assert energy == pytest.approx([5e-4, 0.0], rel=1e-9, abs=1e-15)
+
+
+def test_a_rigid_engine_stores_no_contact_energy():
+    scene = get_scene("stiff-tunnelling")
+    # The same 0.1 mm and 10 N from an engine with rigid contacts (the force is an impulse
+    # over the step, the depth that of a step that captured an impact): no stored energy.
+    trajectory = _ball_and_plate([0.0049, 0.006], normal_forces=[10.0, 0.0])
+    trajectory.metadata["rigid_contacts"] = True
+    assert series.contact_energy(scene, trajectory).tolist() == [0.0, 0.0]
+
+
+def test_a_run_records_whether_its_engine_has_rigid_contacts():
+    scene, settings = get_scene("bouncing-ball-e0.5"), RunSettings(horizon=0.01)
+    assert reference.create().run(scene, settings).metadata["rigid_contacts"] is True
+    assert mujoco.create().run(scene, settings).metadata["rigid_contacts"] is False

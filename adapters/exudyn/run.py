@@ -1,17 +1,17 @@
 """The step loop of an Exudyn run: solver settings, recording, guards, read-out.
 
 Exudyn is stepped by its own ``MainSolverImplicitSecondOrder`` (``InitializeSolver``,
-``SolveSteps``, ``FinalizeSolver``). Option ``step_loop``: 'horizon' (the presets) makes one
+``SolveSteps``, ``FinalizeSolver``). Option ``step_loop``: 'horizon' makes one
 ``SolveSteps`` call over the whole run, as ``exu.SolveDynamic`` does, and leaves Exudyn's step
 control alone: after a step reduced to a contact instant it keeps the short steps through the
 impact and grows them back after ``adaptiveStepRecoverySteps`` good steps; a sample is the
 first step end at or after its time, so sample times can leave the grid by less than a step.
-'grid' makes one call per nominal step ending on the grid; each call restarts at the nominal
-step (``SolveSteps`` resets ``currentStepSize``), so impacts are integrated with full steps
-(measured in docs/engines/exudyn.md). A PostStep user function (called after every accepted
-step, after the discontinuous iterations, and once more at the start of each call: skipped)
-records samples and runs the guards, and stops the solver by returning False. A PreStep
-function applies explicit law loads.
+'grid' (the presets) makes one call per nominal step ending on the grid; each call restarts
+at the nominal step (``SolveSteps`` resets ``currentStepSize``), so impacts are integrated
+with full steps (measured in docs/engines/exudyn.md). A PostStep user function (called
+after every accepted step, after the discontinuous iterations, and once more at the start of
+each call: skipped) records samples and runs the guards, and stops the solver by returning
+False. A PreStep function applies explicit law loads.
 
 Guards:
 - files: ``solution.file.write``, ``solution.sensors.active``, restart files, verbose files

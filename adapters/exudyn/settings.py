@@ -180,7 +180,7 @@ class ExudynSettings:
     discontinuous_max_iterations: int = 5
     discontinuous_tolerance: float = 1.0
     recommended_step: bool = True
-    step_loop: str = "horizon"
+    step_loop: str = "grid"
     linear_solver: str = "EXUdense"
     ignore_singular_jacobian: bool = False
     closed_loop_full_pivot: bool = True

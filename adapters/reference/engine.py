@@ -41,6 +41,7 @@ class ReferenceEngine(Engine):
     """Our nonsmooth reference solver (see :mod:`clearbench.ref_solver.stepper`)."""
 
     name = "reference"
+    RIGID_CONTACTS = True
     PRESETS = PRESETS
     OPTION_NAMES = OPTION_NAMES
 

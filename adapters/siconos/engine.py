@@ -168,6 +168,7 @@ class SiconosEngine(Engine):
     """Siconos 4.4 kernel (Moreau-Jean, fc3d / GenericMechanical) in a worker process."""
 
     name = "siconos"
+    RIGID_CONTACTS = True
     PRESETS = PRESETS
     OPTION_NAMES = OPTION_NAMES
 
