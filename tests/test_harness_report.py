@@ -248,22 +248,22 @@ def test_c60_validation_cache_is_keyed_on_the_physics_code(tmp_path, monkeypatch
     # A cached run is reused only by the same scene, preset and physics code: after a solver
     # change the validation reruns instead of reporting the old solver's figures.
     import clearbench
-    from clearbench.harness.c60 import validation as c60_validation
+    from clearbench.harness.c60 import runs as c60_runs
 
-    first = c60_validation.run_scene("ball", "bouncing-ball-e0", {}, tmp_path)
+    first = c60_runs.run_scene("ball", "bouncing-ball-e0", {}, tmp_path)
     assert first.trajectory.metadata["physics_code"] == clearbench.source_digest(
-        c60_validation.PHYSICS_CODE)
+        c60_runs.PHYSICS_CODE)
     calls = []
-    real_create = c60_validation.create
+    real_create = c60_runs.create
 
     def counting_create(preset):
         calls.append(preset)
         return real_create(preset)
 
-    monkeypatch.setattr(c60_validation, "create", counting_create)
-    again = c60_validation.run_scene("ball", "bouncing-ball-e0", {}, tmp_path)
+    monkeypatch.setattr(c60_runs, "create", counting_create)
+    again = c60_runs.run_scene("ball", "bouncing-ball-e0", {}, tmp_path)
     assert calls == [] and np.array_equal(again.trajectory.positions,
                                           first.trajectory.positions)
-    monkeypatch.setitem(clearbench._SOURCE_DIGESTS, c60_validation.PHYSICS_CODE, "0" * 16)
-    c60_validation.run_scene("ball", "bouncing-ball-e0", {}, tmp_path)
+    monkeypatch.setitem(clearbench._SOURCE_DIGESTS, c60_runs.PHYSICS_CODE, "0" * 16)
+    c60_runs.run_scene("ball", "bouncing-ball-e0", {}, tmp_path)
     assert calls == ["default"]
