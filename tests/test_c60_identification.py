@@ -103,3 +103,39 @@ def test_tilt_is_the_angle_of_the_body_z_axis_from_world_z():
     # Exact up to the round-off of cos/arccos near 3 degrees (1e-12 rad).
     assert analysis.tilt(np.array(about_x)) == pytest.approx(math.radians(3.0), abs=1e-12)
     assert analysis.tilt(np.array(about_z)) == pytest.approx(0.0, abs=1e-7)
+
+
+def test_a_variant_whose_mechanism_opened_matches_no_section_and_is_listed():
+    figures = figures_at_the_paper("latch-0.1")
+    figures.fc_mean["FC-1"] = 0.0      # C7 unloaded over the last millisecond
+    figures.opened = True
+    matches = identification.section_matches(figures)
+    assert matches["4.2"] == f"no: {identification.OPENED}"
+    assert matches["5.2"] == "yes"     # the prototype's run stayed ON
+    lines = identification.opened_lines(Identification(figures=[figures]))
+    assert len(lines) == 1 and "`latch-0.1`" in lines[0]
+    assert "with the prototype's clearances it stayed ON" in lines[0]
+
+
+def test_fc6_is_the_bar_to_plunger_gap_of_table_1():
+    geometry = analysis.magnetic_gap_geometry()
+    # The plunger's face and the case plane are both at x = -5 mm in the CAD's ON pose (the
+    # CAD's coordinates are exact to 1e-6 mm), so the source's pair measures the paper's
+    # "distance between tripping bar and plunger in X"; its value in that pose is 0.389 mm
+    # (to the 1e-3 mm of a length read from the B-spline CAD, residual 1.2e-4 mm).
+    assert geometry.plunger_in_case_plane
+    assert geometry.case_plane_x == pytest.approx(-5.0, abs=1e-6)
+    assert geometry.cad_value == pytest.approx(0.389, abs=1e-3)
+
+
+def test_the_fc6_paragraph_names_the_closest_variant_and_says_when_none_matches():
+    source, latch = figures_at_the_paper("source"), figures_at_the_paper("latch-0.1")
+    sigma = PAPER["functional_conditions"]["FC6"]["sigma"]
+    source.fc_mean["FC-6"] += 7.0 * sigma
+    latch.fc_mean["FC-6"] += 5.0 * sigma
+    text = identification.magnetic_gap_cause(Identification(figures=[source, latch]))
+    assert "closest variant is latch-0.1" in text and "+5.0 sigma" in text
+    assert "no variant of the study puts FC-6 within 2 sigma" in text
+    latch.fc_mean["FC-6"] -= 4.0 * sigma
+    text = identification.magnetic_gap_cause(Identification(figures=[source, latch]))
+    assert "latch-0.1 puts FC-6 within 2 sigma" in text

@@ -239,6 +239,45 @@ def pin_lamage_cause(largest_tilt: float | None = None) -> str:
             f"the measurement the source's pairs make.")
 
 
+#: The plunger's face (the trip coil's magnetic plunger) and the case plane of the FC-6 pair.
+PLUNGER_FACE_FILE = "C60/C8/probe_surface.stp"
+MAGNETIC_CASE_PLANE_FILE = "C60/newFC/Case_Magnetic_Mcontact_FC_X.stp"
+
+
+@dataclass(frozen=True)
+class MagneticGapGeometry:
+    """What the FC-6 pair measures, from the CAD's ON pose [mm]: the world x of the plunger's
+    face and of the case plane the pair measures from, and FC-6 itself in that pose."""
+
+    plunger_face_x: float
+    case_plane_x: float
+    cad_value: float
+
+    @property
+    def plunger_in_case_plane(self) -> bool:
+        """The plunger's face lies in the case plane (within the CAD's 1e-6 mm round-off): the
+        pair is then the tripping bar - plunger distance of the paper's Table 1."""
+        return abs(self.plunger_face_x - self.case_plane_x) <= 1e-6
+
+
+def magnetic_gap_geometry() -> MagneticGapGeometry:
+    """FC-6's geometry in the CAD's ON pose (:class:`MagneticGapGeometry`)."""
+    poses = model.on_poses()
+    face = model.primitives()[PLUNGER_FACE_FILE].primitives[0]
+    plane = model.primitives()[MAGNETIC_CASE_PLANE_FILE].primitives[0]
+    name = model.FUNCTIONAL_CONDITIONS["FC-6"][0]
+    output = next(o for o in model.c60_outputs(poses) if o.name == name)
+
+    def world(body: str, local) -> np.ndarray:
+        local = np.asarray(local, dtype=float)
+        return local if body == model.FRAME else poses[body].point(local)
+
+    axis = "xyz".index(output.component)
+    value = (world(output.body_b, output.point_b) - world(output.body_a, output.point_a))[axis]
+    return MagneticGapGeometry(float(poses[model.PLUNGER].point(face.point)[0]),
+                               float(plane.point[0]), float(value))
+
+
 def _patch_ranges() -> dict[tuple[str, str], tuple[float, float]]:
     """(body, shape) -> angular range of the convex cylinder patches the scene models as full
     cylinders (their own frame: angle from x about z, as :class:`~.shapes.Arc`)."""

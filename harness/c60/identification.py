@@ -110,6 +110,8 @@ class VariantFigures:
     contact_force: float = math.nan                       # N
     contact_travel: float = math.nan                      # mm
     bar_tilt: float = math.nan                            # rad, largest in the last ms
+    opened: bool = False             # the c60-on run at 0.07 mm ended open (C7 unloaded)
+    opened_prototype: bool = False   # the same with the prototype's clearances
     trip_curve: analysis.TripForceCurve | None = None
     notes: list = field(default_factory=list)
 
@@ -133,6 +135,12 @@ def _fc_values(run: Run) -> tuple[dict, dict]:
         output = model.FUNCTIONAL_CONDITIONS[fc][0]
         values[fc], drifts[fc] = settled[output], drift[output]
     return values, drifts
+
+
+def _opened(fc_values: dict) -> bool:
+    """The mechanism did not stay ON: C7 (FC-1) carries no force over the last millisecond
+    (the latch released and the contacts opened)."""
+    return not fc_values["FC-1"] > analysis.FORCE_THRESHOLD
 
 
 def _bar_tilt(run: Run) -> float:
@@ -180,11 +188,13 @@ def identify(cache: Path | None, preset: str = "default",
                 if on is not None:
                     figures.fc_mean, figures.fc_drift = _fc_values(on)
                     figures.bar_tilt = _bar_tilt(on)
+                    figures.opened = _opened(figures.fc_mean)
                 proto = run(f"identify_on_prototype_{variant}", "c60-on",
                             {**candidate.parameters, "clearances": prototype,
                              "horizon": on_horizon})
                 if proto is not None:
                     figures.fc1_prototype = _fc_values(proto)[0]["FC-1"]
+                    figures.opened_prototype = _opened({"FC-1": figures.fc1_prototype})
                 for key, done in (("mean", on), ("prototype", proto)):
                     if done is not None and done.trajectory.status.value != "ok":
                         figures.notes.append(f"c60-on ({key} clearances) ended "
@@ -268,12 +278,23 @@ def sigmas(figures: VariantFigures) -> dict:
             / published[fc.replace("-", "")]["sigma"] for fc in FCS}
 
 
+#: Variants that change the contact-pressure spring's moment, and the moving contact's force
+#: lever alone (FC-6 against FC-1 in the FC-6 paragraph), in increasing order.
+SPRING_MOMENT_SERIES = ("offset-67", "source", "preload-0.6547", "preload-0.9599")
+FORCE_LEVER_SERIES = ("lever-7.99", "source", "lever-4.84")
+
+#: What a run that did not stay ON is called in the table.
+OPENED = "the mechanism opened (C7 carries no force: the latch released)"
+
+
 def section_matches(figures: VariantFigures) -> dict[str, str]:
     """Per paper section: ``yes``, ``no`` (with what misses) or ``-`` (not run)."""
     experiments = _paper()["experiments"]
     out = {}
     z = sigmas(figures)
-    if figures.fc_mean:
+    if figures.opened:
+        out["4.2"] = f"no: {OPENED}"
+    elif figures.fc_mean:
         missed = [f"{fc} {z[fc]:+.1f} sigma" for fc in FCS if not abs(z[fc]) <= SIGMA_MATCH]
         out["4.2"] = "yes" if not missed else "no: " + ", ".join(missed)
     else:
@@ -281,6 +302,8 @@ def section_matches(figures: VariantFigures) -> dict[str, str]:
     force = experiments["contact_force_at_equilibrium_N"]["simulated"]
     if math.isnan(figures.fc1_prototype):
         out["5.2"] = "-"
+    elif figures.opened_prototype:
+        out["5.2"] = f"no: {OPENED}"
     else:
         off = figures.fc1_prototype / force - 1.0
         out["5.2"] = "yes" if abs(off) <= FORCE_MATCH else f"no: FC-1 {100 * off:+.0f} %"
@@ -301,6 +324,81 @@ def section_matches(figures: VariantFigures) -> dict[str, str]:
 # ------------------------------------------------------------------------------------------------
 # Report
 # ------------------------------------------------------------------------------------------------
+
+
+def magnetic_gap_cause(study: Identification, sheet_value: float | None = None) -> str:
+    """What FC-6 measures and why it differs from the paper's mean, with the study's figures
+    (``sheet_value``: FC-6 with the sheet's clearances [mm], when the caller ran it)."""
+    geometry = analysis.magnetic_gap_geometry()
+    fc6 = _paper()["functional_conditions"]["FC6"]
+    held = [f for f in study.figures if f.fc_mean and not f.opened]
+    by_name = {f.candidate.name: f for f in held}
+    where = ("lies in that plane" if geometry.plunger_in_case_plane else
+             f"lies at x = {geometry.plunger_face_x:.3f} mm, not in that plane")
+    text = (f"FC-6 is the paper's 'distance between tripping bar and plunger in X' (Table 1): "
+            f"the source's pair measures the x distance from the tripping bar's magnetic face "
+            f"to the case plane x = {geometry.case_plane_x:g} mm, and the plunger's face "
+            f"{where} in the ON pose, so the pair is that distance while the plunger rests. "
+            f"In the CAD's ON pose it is {geometry.cad_value:.3f} mm")
+    source = by_name.get("source")
+    settled = []
+    if sheet_value is not None:
+        settled.append(f"{sheet_value:.3f} mm with the sheet's clearances (about 0.021 mm)")
+    if source is not None:
+        settled.append(f"{source.fc_mean['FC-6']:.3f} mm with every joint at "
+                       f"{MEAN_CLEARANCE} mm")
+    if settled:
+        text += "; at equilibrium it is " + " and ".join(settled)
+    text += f" (paper's Monte Carlo mean {fc6['mean']} ± {fc6['sigma']} mm)"
+
+    def series(names: Sequence[str]) -> str:
+        return ", ".join(f"{name} {by_name[name].fc_mean['FC-1']:.2f} N, "
+                         f"{by_name[name].fc_mean['FC-6']:.3f} mm"
+                         for name in names if name in by_name)
+
+    if all(name in by_name for name in (*SPRING_MOMENT_SERIES, *FORCE_LEVER_SERIES)):
+        text += (". It follows the contact-pressure spring's moment, which the plate passes "
+                 "to the latch, not FC-1: the preload and the angle offset change both (FC-1, "
+                 f"FC-6: {series(SPRING_MOMENT_SERIES)}), the moving contact's force lever "
+                 f"changes FC-1 alone ({series(FORCE_LEVER_SERIES)})")
+    if held:
+        closest = min(held, key=lambda f: abs(sigmas(f)["FC-6"]))
+        text += (f". The closest variant is {closest.candidate.name} at "
+                 f"{closest.fc_mean['FC-6']:.3f} mm ({sigmas(closest)['FC-6']:+.1f} sigma), "
+                 f"with FC-1 at {closest.fc_mean['FC-1']:.2f} N; no variant of the study puts "
+                 f"FC-6 within {SIGMA_MATCH:g} sigma of the paper's mean" if not any(
+                     abs(sigmas(f)["FC-6"]) <= SIGMA_MATCH for f in held) else
+                 f". {closest.candidate.name} puts FC-6 within {SIGMA_MATCH:g} sigma of the "
+                 f"paper's mean ({closest.fc_mean['FC-6']:.3f} mm)")
+    paper_moved = fc6["mean"] - geometry.cad_value
+    text += (f". From the CAD's pose to equilibrium the paper's mean moves the bar "
+             f"{paper_moved:+.3f} mm")
+    if source is not None:
+        moved = source.fc_mean["FC-6"] - geometry.cad_value
+        text += f", the source's model at the mean clearances {moved:+.3f} mm"
+        if held and not any(abs(sigmas(f)["FC-6"]) <= SIGMA_MATCH for f in held):
+            sense = "less" if moved > paper_moved else "more"
+            text += f"; what makes the paper's bar move {sense} is none of this study's variants"
+    return text + "."
+
+
+def opened_lines(study: Identification) -> list[str]:
+    """One line per variant whose c60-on run did not stay ON."""
+    lines = []
+    for figures in study.figures:
+        runs = [label for label, opened in ((f"every joint at {MEAN_CLEARANCE} mm",
+                                             figures.opened),
+                                            ("the prototype's clearances",
+                                             figures.opened_prototype)) if opened]
+        if not runs:
+            continue
+        held = ("" if len(runs) == 2 else
+                f"; with {'the prototype' if figures.opened else 'the mean'}'s clearances it "
+                f"stayed ON")
+        lines.append(f"- `{figures.candidate.name}` ({figures.label}): {OPENED} with "
+                     f"{' and with '.join(runs)}{held}. Its FC-2..FC-6 are those of the open "
+                     f"mechanism, not of the ON state.")
+    return lines
 
 
 def _f(value: float, digits: int) -> str:
@@ -347,9 +445,9 @@ def table_lines(study: Identification) -> list[str]:
 
 def write_markdown(study: Identification, path: Path, preset: str, on_horizon: float) -> None:
     """The identification table with how it was computed and the runs behind it."""
-    drifts = {fc: max((abs(f.fc_drift[fc]) for f in study.figures if f.fc_drift),
-                      default=math.nan) for fc in FCS}
-    tilts = [f.bar_tilt for f in study.figures if not math.isnan(f.bar_tilt)]
+    held = [f for f in study.figures if f.fc_drift and not f.opened]
+    drifts = {fc: max((abs(f.fc_drift[fc]) for f in held), default=math.nan) for fc in FCS}
+    tilts = [f.bar_tilt for f in study.figures if not math.isnan(f.bar_tilt) and not f.opened]
     lines = [
         "# C-60 identification: which model did the paper run?",
         "",
@@ -369,11 +467,16 @@ def write_markdown(study: Identification, path: Path, preset: str, on_horizon: f
     ]
     lines += table_lines(study)
     lines += ["", "Largest change of each FC over its averaging millisecond (is it settled?), "
-              "over the variants: " + ", ".join(
+              "over the variants that stayed ON: " + ", ".join(
                   f"{fc} {drifts[fc]:.3f} {'N' if fc == 'FC-1' else 'mm'}" for fc in FCS)
               + ".", ""]
     lines += ["## FC-2..FC-5 against the paper", "",
               analysis.pin_lamage_cause(max(tilts) if tilts else None), ""]
+    if any(f.fc_mean for f in study.figures):
+        lines += ["## FC-6 against the paper", "", magnetic_gap_cause(study), ""]
+    opened = opened_lines(study)
+    if opened:
+        lines += ["## Variants whose mechanism did not stay ON", "", *opened, ""]
     notes = [f"- `{f.candidate.name}`: {'; '.join(f.notes)}" for f in study.figures
              if f.notes]
     if notes:

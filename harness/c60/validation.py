@@ -8,6 +8,7 @@ trajectory file keyed by the scene's content hash), computes the figures and ret
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
 import math
@@ -17,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from clearbench.harness.c60 import analysis, identification
+from clearbench.harness.c60.identification import ON_HORIZON
 from clearbench.harness.c60.runs import PHYSICS_CODE, Run, run_scene  # noqa: F401 (re-exported)
 from clearbench.harness.measure import series as metrics
 from clearbench.kernels.quaternion import quat_to_matrix
@@ -74,8 +76,10 @@ def _paper() -> dict:
 #: Variants of the identification study whose figures the validation shows beside the
 #: source's model and uses for the measured causes of its differences (runs shared with
 #: ``clearbench c60 identify`` through the cache).
-SENSITIVITY_VARIANTS = identification.candidates("preload-0.9599", "paper-table-4",
-                                                 "latch-0.1")
+SENSITIVITY_VARIANTS = (
+    dataclasses.replace(identification.candidates("source")[0], trip_test=False,
+                        contact_test=False),
+    *identification.candidates("preload-0.9599", "paper-table-4", "latch-0.1"))
 
 
 def _variant_rows(study: identification.Identification, report: ValidationReport) -> None:
@@ -86,6 +90,16 @@ def _variant_rows(study: identification.Identification, report: ValidationReport
     peak = experiments["trip_test_peak_force_N"]
     distance = experiments["trip_test_total_distance_mm"]
     for figures in study.figures:
+        if figures.candidate.name == "source":
+            for fc in identification.FCS:
+                key = fc.replace("-", "")
+                output, description = model.FUNCTIONAL_CONDITIONS[fc]
+                report.rows.append(Row(
+                    f"{fc}, {output}, every joint at {identification.MEAN_CLEARANCE} mm (the "
+                    "clearance law's mean) vs Monte Carlo mean", "N" if fc == "FC-1" else "mm",
+                    figures.fc_mean[fc], fcs[key]["mean"],
+                    note=f"sigma {fcs[key]['sigma']}; c60-on for {ON_HORIZON:g} ms"))
+            continue
         note = f"variant {figures.candidate.variant}: {figures.label}; not the model"
         report.rows.append(Row("FC-1, prototype clearances", "N", figures.fc1_prototype,
                                force["simulated"], force["measured"], note=note))
@@ -128,13 +142,14 @@ def validate(cache: Path | None = None, preset: str = "default", speed_check: bo
         "FC-1, C7 force at equilibrium, prototype clearances (c60-on)", "N",
         settled_proto["FC1_contact_force"], force["simulated"], force["measured"]))
     report.rows.append(Row(
-        "FC-1, nominal clearances (c60-on) vs Monte Carlo mean", "N",
+        "FC-1, the sheet's nominal clearances (c60-on) vs Monte Carlo mean", "N",
         settled["FC1_contact_force"], fcs["FC1"]["mean"],
         note=f"Monte Carlo range {fcs['FC1']['range'][0]}-{fcs['FC1']['range'][1]} N"))
     for fc, key in (("FC-2", "FC2"), ("FC-3", "FC3"), ("FC-4", "FC4"), ("FC-5", "FC5"),
                     ("FC-6", "FC6")):
         output, description = model.FUNCTIONAL_CONDITIONS[fc]
-        report.rows.append(Row(f"{fc}, {output} (c60-on, nominal) vs Monte Carlo mean", "mm",
+        report.rows.append(Row(f"{fc}, {output} (c60-on, the sheet's nominal clearances) vs "
+                               "Monte Carlo mean", "mm",
                                settled[output], fcs[key]["mean"],
                                note=f"sigma {fcs[key]['sigma']} mm; {description}"))
     # The magnetic trip.
@@ -178,10 +193,12 @@ def validate(cache: Path | None = None, preset: str = "default", speed_check: bo
                            distance["simulated"], distance["measured"]))
     report.findings.append(_first_contact_phase(trip_test))
     if sensitivity:
-        study = identification.identify(cache, preset, SENSITIVITY_VARIANTS)
+        study = identification.identify(cache, preset, SENSITIVITY_VARIANTS, calibrate=False)
         report.runs.update(study.runs)
         _variant_rows(study, report)
-        report.causes = measured_causes(study)
+        report.causes = measured_causes(study, settled[model.FUNCTIONAL_CONDITIONS["FC-6"][0]])
+    else:
+        report.causes = default_causes(settled[model.FUNCTIONAL_CONDITIONS["FC-6"][0]])
     report.findings.append(explain_contact_force(nominal))
     if speed_check:
         base_speed = _probe_speed(trip_test.scene)
@@ -369,9 +386,19 @@ DIFFERENCE_CAUSES = (
 )
 
 
-def measured_causes(study: identification.Identification) -> tuple:
-    """DIFFERENCE_CAUSES with the figures the study's variants measured."""
-    by_name = {f.candidate.variant: f for f in study.figures}
+def default_causes(sheet_fc6: float | None = None) -> tuple:
+    """DIFFERENCE_CAUSES with FC-6's (its geometry, and ``sheet_fc6``: FC-6 with the sheet's
+    clearances [mm]) before the FC-2..FC-5 entry."""
+    fc6 = ("FC-6", identification.magnetic_gap_cause(identification.Identification(),
+                                                      sheet_fc6))
+    return (*DIFFERENCE_CAUSES[:2], fc6, *DIFFERENCE_CAUSES[2:])
+
+
+def measured_causes(study: identification.Identification, sheet_fc6: float | None = None
+                    ) -> tuple:
+    """DIFFERENCE_CAUSES with the figures the study's variants measured (``sheet_fc6``: FC-6
+    with the sheet's clearances [mm])."""
+    by_name = {f.candidate.name: f for f in study.figures}
     preload = by_name["preload-0.9599"]
     latch = by_name["latch-0.1"]
     table_4 = by_name["paper-table-4"]
@@ -400,14 +427,15 @@ def measured_causes(study: identification.Identification) -> tuple:
             f"paper-table-4): peak {table_4.trip_peak:.2f} N. The preload that moves FC-1 onto "
             f"the paper's loads the latch more: preload 0.9599 rad gives "
             f"{preload.trip_peak:.2f} N.")
-    return (("FC-1", fc1), DIFFERENCE_CAUSES[1], DIFFERENCE_CAUSES[2],
+    return (("FC-1", fc1), DIFFERENCE_CAUSES[1],
+            ("FC-6", identification.magnetic_gap_cause(study, sheet_fc6)), DIFFERENCE_CAUSES[2],
             ("Trip test: peak force", trip))
 
 
 def difference_cause(quantity: str, causes: tuple = ()) -> str:
     """What causes the difference of the row ``quantity`` (``causes``, else
-    DIFFERENCE_CAUSES)."""
-    for prefix, cause in causes or DIFFERENCE_CAUSES:
+    :func:`default_causes`)."""
+    for prefix, cause in causes or default_causes():
         if quantity.startswith(prefix):
             return cause
     return "not analysed."
@@ -443,9 +471,12 @@ def write_markdown(report: ValidationReport, path: Path, figures: dict[str, Path
     for fc, (output, description) in model.FUNCTIONAL_CONDITIONS.items():
         lines.append(f"- {fc}: output `{output}`, {description}; averaged over the last "
                      "millisecond of c60-on.")
-    lines += ["- The paper's Monte Carlo means pair oddly with the measurement pairs' names "
-              "(FC-2 10.72 mm is near the lamage axis x, FC-4 10.60 mm near the pin x): "
-              "both readings are in the table's figures.", ""]
+    gap = analysis.magnetic_gap_geometry()
+    if gap.plunger_in_case_plane:
+        lines.append(f"- FC-6's case plane x = {gap.case_plane_x:g} mm holds the plunger's face in "
+                     "the ON pose: the pair is the paper's tripping bar - plunger distance "
+                     f"(Table 1); {gap.cad_value:.3f} mm in the CAD's ON pose.")
+    lines.append("")
     lines += ["## Model notes", ""]
     lines += [f"- {note}" for note in MODEL_NOTES]
     lines += ["", "## Findings", ""]
