@@ -139,3 +139,14 @@ def test_the_fc6_paragraph_names_the_closest_variant_and_says_when_none_matches(
     latch.fc_mean["FC-6"] -= 4.0 * sigma
     text = identification.magnetic_gap_cause(Identification(figures=[source, latch]))
     assert "latch-0.1 puts FC-6 within 2 sigma" in text
+
+
+def test_the_running_median_drops_a_one_sample_spike_at_either_end():
+    # The probe's first touch is an impact: one recorded sample of several newtons before the
+    # quasi-static load (the preload-0.9599 trip test: 5.2 N, then 0.36 N). A width-5 median
+    # must give the neighbours' values there, exactly (a median picks a sample).
+    values = np.array([5.2, 0.0, 0.0, 0.36, 0.37, 0.38, 0.0, 9.0])
+    smooth = analysis.running_median(values, 5)
+    assert smooth[0] == 0.0 and smooth[-1] == 0.38
+    assert smooth.max() == 0.38
+    assert analysis.running_median(np.array([1.0]), 5).tolist() == [1.0]

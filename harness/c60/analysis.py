@@ -110,10 +110,13 @@ class TripForceCurve:
 
 
 def running_median(values: np.ndarray, width: int) -> np.ndarray:
-    """Median of each window of ``width`` (odd) samples centred on each sample (edges padded
-    with the end values)."""
-    half = width // 2
-    padded = np.concatenate((np.full(half, values[0]), values, np.full(half, values[-1])))
+    """Median of each window of ``width`` (odd) samples centred on each sample. The edges are
+    mirrored about the end samples (numpy's ``reflect``), so a single-sample spike at an end
+    (the probe's first touch, an impact) is filtered out like one inside; padding with the end
+    value would repeat it ``width // 2`` times and keep it."""
+    half = min(width // 2, values.size - 1)
+    padded = np.pad(values, half, mode="reflect")
+    width = 2 * half + 1
     windows = np.lib.stride_tricks.sliding_window_view(padded, width)
     return np.median(windows, axis=1)
 

@@ -207,6 +207,11 @@ def identify(cache: Path | None, preset: str = "default",
                 if trip is None:
                     continue
                 curve = analysis.trip_force_curve(trip.scene, trip.trajectory)
+                if curve.displacement.size == 0:
+                    figures.notes.append(
+                        "trip test: the probe never loaded the tripping bar" + (
+                            " (with the prototype's clearances the mechanism opened by itself "
+                            "in c60-on)" if figures.opened_prototype else ""))
                 figures.trip_peak = curve.peak_force
                 figures.trip_peak_at = curve.peak_displacement
                 figures.trip_distance = curve.trip_distance
@@ -480,7 +485,7 @@ def write_markdown(study: Identification, path: Path, preset: str, on_horizon: f
     notes = [f"- `{f.candidate.name}`: {'; '.join(f.notes)}" for f in study.figures
              if f.notes]
     if notes:
-        lines += ["## Runs that did not end ok", "", *notes, ""]
+        lines += ["## Notes on runs", "", *notes, ""]
     if study.missing:
         lines += ["## Runs not made", "", "Not in the cache when this table was written "
                   "(`--cached-only`); their cells are '-': " + ", ".join(study.missing) + ".",
