@@ -30,7 +30,10 @@ from clearbench.harness.studies.campaign.definition import (
 )
 from clearbench.harness.studies.campaign.designs import sample_inputs, scene_parameters
 from clearbench.harness.studies.campaign.execution import plan_samples, run_campaign
-from clearbench.harness.studies.campaign.report import write_campaign_report
+from clearbench.harness.studies.campaign.report import (
+    load_written_sections,
+    write_campaign_report,
+)
 from clearbench.harness.studies.campaign.results import campaign_table, collect
 from clearbench.harness.studies.campaign.statistics import (
     capability,
@@ -307,6 +310,17 @@ def test_a_campaign_runs_on_a_local_cluster_resumes_and_reports(tmp_path):
     markdown = paths["markdown"].read_text()
     assert "## Tolerance campaign `pendulum-test`" in markdown
     assert (tmp_path / "report" / "figures" / "pendulum-test_final_angle_histogram.png").exists()
+
+
+def test_the_report_lists_a_study_before_the_companions_named_after_it(tmp_path):
+    # sorted by file name, "c60-paper-mc.json" came before "c60-paper.json" ('-' < '.'), and
+    # the comparison report opened with a companion instead of the study
+    for name in ("c60-paper-mc-identified", "c60-paper", "c60-paper-mc"):
+        summary = {"definition": {"name": name}, "outputs": []}
+        (tmp_path / f"{name}.json").write_text(json.dumps(summary), encoding="utf-8")
+    (tmp_path / "not-a-campaign.json").write_text("{}", encoding="utf-8")
+    names = [summary["definition"]["name"] for summary, _ in load_written_sections(tmp_path)]
+    assert names == ["c60-paper", "c60-paper-mc", "c60-paper-mc-identified"]
 
 
 def _recorded_keys(log: Path) -> list[str]:

@@ -323,10 +323,11 @@ def render_html(summary: dict, pngs: dict[str, bytes]) -> str:
 
 def load_written_sections(folder: str | Path) -> list[tuple[dict, dict[str, bytes]]]:
     """The campaign sections written by :func:`write_campaign_report` into ``folder``: each
-    summary with its figures (file name -> PNG), by campaign name."""
+    summary with its figures (file name -> PNG), by campaign name (a study before the
+    companions named after it: ``c60-paper``, ``c60-paper-mc``, ``c60-paper-mc-identified``)."""
     folder = Path(folder)
     sections = []
-    for path in sorted(folder.glob("*.json")):
+    for path in sorted(folder.glob("*.json"), key=lambda path: path.stem):
         summary = json.loads(path.read_text(encoding="utf-8"))
         if "definition" not in summary or "outputs" not in summary:
             continue
