@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -263,20 +264,18 @@ class MagneticGapGeometry:
         return abs(self.plunger_face_x - self.case_plane_x) <= 1e-6
 
 
+@lru_cache(maxsize=1)
 def magnetic_gap_geometry() -> MagneticGapGeometry:
-    """FC-6's geometry in the CAD's ON pose (:class:`MagneticGapGeometry`)."""
-    poses = model.on_poses()
+    """FC-6's geometry in the CAD's ON pose (:class:`MagneticGapGeometry`; a property of the
+    CAD, computed once per process)."""
+    poses = model.on_poses()   # the frame's pose included (identity)
     face = model.primitives()[PLUNGER_FACE_FILE].primitives[0]
     plane = model.primitives()[MAGNETIC_CASE_PLANE_FILE].primitives[0]
     name = model.FUNCTIONAL_CONDITIONS["FC-6"][0]
     output = next(o for o in model.c60_outputs(poses) if o.name == name)
-
-    def world(body: str, local) -> np.ndarray:
-        local = np.asarray(local, dtype=float)
-        return local if body == model.FRAME else poses[body].point(local)
-
     axis = "xyz".index(output.component)
-    value = (world(output.body_b, output.point_b) - world(output.body_a, output.point_a))[axis]
+    value = (poses[output.body_b].point(np.asarray(output.point_b, dtype=float))
+             - poses[output.body_a].point(np.asarray(output.point_a, dtype=float)))[axis]
     return MagneticGapGeometry(float(poses[model.PLUNGER].point(face.point)[0]),
                                float(plane.point[0]), float(value))
 

@@ -137,10 +137,10 @@ def _fc_values(run: Run) -> tuple[dict, dict]:
     return values, drifts
 
 
-def _opened(fc_values: dict) -> bool:
-    """The mechanism did not stay ON: C7 (FC-1) carries no force over the last millisecond
-    (the latch released and the contacts opened)."""
-    return not fc_values["FC-1"] > analysis.FORCE_THRESHOLD
+def _opened(fc1: float) -> bool:
+    """The mechanism did not stay ON: C7 carries no force (``fc1``: FC-1 over the last
+    millisecond [N]; the latch released and the contacts opened)."""
+    return not fc1 > analysis.FORCE_THRESHOLD
 
 
 def _bar_tilt(run: Run) -> float:
@@ -188,13 +188,13 @@ def identify(cache: Path | None, preset: str = "default",
                 if on is not None:
                     figures.fc_mean, figures.fc_drift = _fc_values(on)
                     figures.bar_tilt = _bar_tilt(on)
-                    figures.opened = _opened(figures.fc_mean)
+                    figures.opened = _opened(figures.fc_mean["FC-1"])
                 proto = run(f"identify_on_prototype_{variant}", "c60-on",
                             {**candidate.parameters, "clearances": prototype,
                              "horizon": on_horizon})
                 if proto is not None:
                     figures.fc1_prototype = _fc_values(proto)[0]["FC-1"]
-                    figures.opened_prototype = _opened({"FC-1": figures.fc1_prototype})
+                    figures.opened_prototype = _opened(figures.fc1_prototype)
                 for key, done in (("mean", on), ("prototype", proto)):
                     if done is not None and done.trajectory.status.value != "ok":
                         figures.notes.append(f"c60-on ({key} clearances) ended "
@@ -366,14 +366,16 @@ def magnetic_gap_cause(study: Identification, sheet_value: float | None = None) 
                  "to the latch, not FC-1: the preload and the angle offset change both (FC-1, "
                  f"FC-6: {series(SPRING_MOMENT_SERIES)}), the moving contact's force lever "
                  f"changes FC-1 alone ({series(FORCE_LEVER_SERIES)})")
-    if held:
-        closest = min(held, key=lambda f: abs(sigmas(f)["FC-6"]))
+    # the variant nearest the paper's mean; none is within SIGMA_MATCH unless it is
+    closest = min(held, key=lambda f: abs(sigmas(f)["FC-6"])) if held else None
+    none_matches = closest is not None and not abs(sigmas(closest)["FC-6"]) <= SIGMA_MATCH
+    if none_matches:
         text += (f". The closest variant is {closest.candidate.name} at "
                  f"{closest.fc_mean['FC-6']:.3f} mm ({sigmas(closest)['FC-6']:+.1f} sigma), "
                  f"with FC-1 at {closest.fc_mean['FC-1']:.2f} N; no variant of the study puts "
-                 f"FC-6 within {SIGMA_MATCH:g} sigma of the paper's mean" if not any(
-                     abs(sigmas(f)["FC-6"]) <= SIGMA_MATCH for f in held) else
-                 f". {closest.candidate.name} puts FC-6 within {SIGMA_MATCH:g} sigma of the "
+                 f"FC-6 within {SIGMA_MATCH:g} sigma of the paper's mean")
+    elif closest is not None:
+        text += (f". {closest.candidate.name} puts FC-6 within {SIGMA_MATCH:g} sigma of the "
                  f"paper's mean ({closest.fc_mean['FC-6']:.3f} mm)")
     paper_moved = fc6["mean"] - geometry.cad_value
     text += (f". From the CAD's pose to equilibrium the paper's mean moves the bar "
@@ -381,7 +383,7 @@ def magnetic_gap_cause(study: Identification, sheet_value: float | None = None) 
     if source is not None:
         moved = source.fc_mean["FC-6"] - geometry.cad_value
         text += f", the source's model at the mean clearances {moved:+.3f} mm"
-        if held and not any(abs(sigmas(f)["FC-6"]) <= SIGMA_MATCH for f in held):
+        if none_matches:
             sense = "less" if moved > paper_moved else "more"
             text += f"; what makes the paper's bar move {sense} is none of this study's variants"
     return text + "."

@@ -93,7 +93,7 @@ def _variant_rows(study: identification.Identification, report: ValidationReport
         if figures.candidate.name == "source":
             for fc in identification.FCS:
                 key = fc.replace("-", "")
-                output, description = model.FUNCTIONAL_CONDITIONS[fc]
+                output = model.FUNCTIONAL_CONDITIONS[fc][0]
                 report.rows.append(Row(
                     f"{fc}, {output}, every joint at {identification.MEAN_CLEARANCE} mm (the "
                     "clearance law's mean) vs Monte Carlo mean", "N" if fc == "FC-1" else "mm",
@@ -192,13 +192,14 @@ def validate(cache: Path | None = None, preset: str = "default", speed_check: bo
     report.rows.append(Row("Trip test: total trip distance", "mm", trip_curve.trip_distance,
                            distance["simulated"], distance["measured"]))
     report.findings.append(_first_contact_phase(trip_test))
+    sheet_fc6 = settled[model.FUNCTIONAL_CONDITIONS["FC-6"][0]]
     if sensitivity:
         study = identification.identify(cache, preset, SENSITIVITY_VARIANTS, calibrate=False)
         report.runs.update(study.runs)
         _variant_rows(study, report)
-        report.causes = measured_causes(study, settled[model.FUNCTIONAL_CONDITIONS["FC-6"][0]])
+        report.causes = measured_causes(study, sheet_fc6)
     else:
-        report.causes = default_causes(settled[model.FUNCTIONAL_CONDITIONS["FC-6"][0]])
+        report.causes = default_causes(sheet_fc6)
     report.findings.append(explain_contact_force(nominal))
     if speed_check:
         base_speed = _probe_speed(trip_test.scene)
