@@ -8,11 +8,13 @@ time profiles),
 subpackage per engine) and ``clearbench.harness`` (runner, metrics, store, report, CLI).
 
 Importing the package points numba's on-disk cache (``NUMBA_CACHE_DIR``, unless the user set
-it) at a directory named after the state of the package's sources. numba keys a cached kernel
-on its own file only: a kernel that inlines a function from another module would otherwise keep
-running the old code after that module is edited (it did once, and hid a fix).
+it) at a directory named after the state of the package's sources (and numba's code-generation
+settings, when set: :func:`numba_cache_dir`). numba keys a cached kernel on its own file only: a
+kernel that inlines a function from another module would otherwise keep running the old code
+after that module is edited (it did once, and hid a fix).
 """
 
+import functools
 import hashlib
 import importlib.util
 import os
@@ -36,8 +38,10 @@ def _source_files(subpackages: tuple[str, ...]):
                 yield name, path.relative_to(root).as_posix(), path
 
 
+@functools.cache
 def _sources_fingerprint() -> str:
-    """Digest of the path, size and modification time of every source file [hex, 16 chars]."""
+    """Digest of the path, size and modification time of every source file [hex, 16 chars],
+    computed once per process (every cache directory a process names is of one state)."""
     digest = hashlib.sha1(__version__.encode())
     for _, _, path in _source_files(_SUBPACKAGES):
         stat = path.stat()
@@ -66,19 +70,48 @@ _SOURCE_DIGESTS: dict[tuple[str, ...], str] = {}
 _KEEP_CACHES = 4
 
 
-def _set_numba_cache_dir() -> None:
-    if os.environ.get("NUMBA_CACHE_DIR"):
-        return
+#: numba settings that change the machine code it generates. numba keys a cached kernel on the
+#: CPU name and features but not on the optimisation level: a process run with ``NUMBA_OPT=0``
+#: would load the optimised code compiled before. A run with any of these set gets a cache
+#: directory of its own.
+NUMBA_CODEGEN_VARIABLES = ("NUMBA_OPT", "NUMBA_CPU_NAME", "NUMBA_CPU_FEATURES",
+                           "NUMBA_FASTMATH", "NUMBA_LOOP_VECTORIZE", "NUMBA_SLP_VECTORIZE")
+
+#: ``NUMBA_CACHE_DIR`` as the user gave it (None: chosen by :func:`numba_cache_dir`).
+USER_NUMBA_CACHE_DIR = os.environ.get("NUMBA_CACHE_DIR") or None
+
+
+def _checkout_cache_root() -> Path:
     # One folder per checkout: the pruning below must not delete the live cache of another
     # checkout (worktrees working side by side recompiled every kernel, or crashed on a cache
     # file removed under them, when they shared one folder).
     checkout = hashlib.sha1(str(Path(__file__).resolve().parent.parent).encode()).hexdigest()
-    root = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) \
+    return Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) \
         / "clearbench-numba-checkouts" / checkout[:12]
-    current = root / _sources_fingerprint()
+
+
+def numba_cache_dir(environ=None) -> Path:
+    """numba's cache directory for this checkout, the state of its sources and the numba
+    code-generation settings of ``environ`` (default ``os.environ``;
+    :data:`NUMBA_CODEGEN_VARIABLES`): a sub-directory per combination of those that are set."""
+    environ = os.environ if environ is None else environ
+    current = _checkout_cache_root() / _sources_fingerprint()
+    codegen = [f"{name}={environ[name]}" for name in NUMBA_CODEGEN_VARIABLES
+               if environ.get(name)]
+    if codegen:
+        slug = hashlib.sha1(";".join(codegen).encode()).hexdigest()[:12]
+        current = current / f"codegen-{slug}"
+    return current
+
+
+def _set_numba_cache_dir() -> None:
+    if USER_NUMBA_CACHE_DIR:
+        return
+    current = numba_cache_dir()
     os.environ["NUMBA_CACHE_DIR"] = str(current)
+    root = _checkout_cache_root()
     try:
-        older = sorted((d for d in root.iterdir() if d != current),
+        older = sorted((d for d in root.iterdir() if d.name != current.relative_to(root).parts[0]),
                        key=lambda d: d.stat().st_mtime, reverse=True)
     except OSError:  # no cache yet
         return

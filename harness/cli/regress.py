@@ -11,7 +11,9 @@ from clearbench.harness.studies.regress import (
     DEFAULT_BASELINE,
     compare,
     load_baseline,
+    measure_baseline,
     run_suite,
+    suite_entries,
     suite_specs,
     updated_baseline,
     write_baseline,
@@ -23,16 +25,19 @@ def register(subparsers) -> None:
         "regress", help="compare a quick suite with the committed baseline",
         description="Run the quick suite of the baseline file (every available engine on a "
         "few smoke scenes with short horizons, and a short c60-on each) in a fresh temporary "
-        "store and compare status, expectations and every metric with the baseline, within the "
-        "per-engine, per-metric tolerances stated in the file. Exit status 1 naming each "
-        "regression (engine, scene, figure, and whether the engine's version changed); an "
-        "engine not available here is skipped with a note; --update rewrites the baseline's "
-        "results instead.",
+        "store and compare status, expectations and every figure with the baseline, each "
+        "against the tolerance measured for it (exact within its round-off spread, bounded, "
+        "or within the range of an ensemble: docs/harness.md#regression). Exit status 1 "
+        "naming each regression (engine, scene, figure, criterion, and whether the engine's "
+        "version changed); an engine not available here is skipped with a note. --update "
+        "re-measures the baseline: every run as given and under each perturbation the file "
+        "lists (round-off of the initial state, numba and OpenBLAS code paths, an engine's "
+        "own arithmetic settings), about five times the time of a check.",
     )
     parser.add_argument("--baseline", default=str(DEFAULT_BASELINE), metavar="FILE",
                         help=f"baseline file (default {DEFAULT_BASELINE})")
     parser.add_argument("--update", action="store_true",
-                        help="rewrite the baseline's results from this run")
+                        help="re-measure the baseline's results and tolerances")
     parser.add_argument("--jobs", "-j", type=int, default=None,
                         help="parallel workers (default: usable cores)")
     parser.add_argument("--runs-per-worker", type=int, default=1, metavar="N",
@@ -44,26 +49,23 @@ def register(subparsers) -> None:
 
 def run_regress(args: argparse.Namespace) -> int:
     start = time.monotonic()
+    modules = engine_modules(args)
     try:
         baseline = load_baseline(args.baseline)
         skipped: dict[str, str] = {}
-        specs = suite_specs(baseline, engine_modules(args), skipped)
+        specs = suite_specs(baseline, modules, skipped)
+        entries = {ident: entry for ident, entry in suite_entries(baseline, modules).items()
+                   if ident in specs}
     except RunInputError as error:
         raise UserError(f"{args.baseline}: {error}") from None
     except ValueError as error:
         raise UserError(f"{args.baseline}: not a baseline file: {error}") from None
     if args.runs_per_worker < 1 or (args.jobs is not None and args.jobs < 1):
         raise UserError("--jobs and --runs-per-worker must be >= 1")
+    if args.update:
+        return _update(args, baseline, entries, specs, skipped, modules, start)
     results = run_suite(specs, jobs=args.jobs, runs_per_worker=args.runs_per_worker)
     elapsed = time.monotonic() - start
-    if args.update:
-        write_baseline(args.baseline, updated_baseline(baseline, results, skipped))
-        statuses = ", ".join(f"{i} {r['status']}" for i, r in results.items())
-        print(f"baseline {args.baseline} updated from {len(results)} runs in {elapsed:.1f} s "
-              f"({statuses})")
-        for ident, why in skipped.items():
-            print(f"note: {ident}: not run, its baseline result kept ({why})")
-        return 0
     outcome = compare(baseline, results, skipped)
     for note in outcome.notes:
         print(f"note: {note}")
@@ -73,5 +75,30 @@ def run_regress(args: argparse.Namespace) -> int:
             print(f"  {line}")
         return 1
     print(f"no regression: {outcome.runs} runs, {outcome.compared_figures} figures within "
-          f"tolerance of {args.baseline} ({elapsed:.1f} s)")
+          f"their measured tolerances of {args.baseline} ({elapsed:.1f} s)")
+    return 0
+
+
+def _update(args, baseline, entries, specs, skipped, modules, start) -> int:
+    def announce(label: str, runs: int) -> None:
+        print(f"measuring: {runs} runs ({label}), {time.monotonic() - start:.0f} s so far",
+              flush=True)
+
+    measured = measure_baseline(entries, specs, baseline["perturbations"], modules,
+                                jobs=args.jobs, runs_per_worker=args.runs_per_worker,
+                                on_group=announce)
+    results = measured["results"]
+    cost = {"runs": measured["runs"], "worker_seconds": measured["worker_seconds"],
+            "seconds": measured["seconds"]}
+    write_baseline(args.baseline, updated_baseline(baseline, results, skipped, cost))
+    statuses = ", ".join(f"{i} {r['status']}" for i, r in results.items())
+    kinds: dict[str, int] = {}
+    for result in results.values():
+        for check in result["checks"].values():
+            kinds[check["kind"]] = kinds.get(check["kind"], 0) + 1
+    print(f"baseline {args.baseline} re-measured from {measured['runs']} runs in "
+          f"{time.monotonic() - start:.1f} s ({statuses})")
+    print("figures: " + ", ".join(f"{n} {k}" for k, n in sorted(kinds.items())))
+    for ident, why in skipped.items():
+        print(f"note: {ident}: not run, its baseline result kept ({why})")
     return 0

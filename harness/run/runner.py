@@ -23,10 +23,12 @@ import os
 import signal
 import time
 from collections import deque
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import clearbench
 from clearbench.adapters.trajectory import RunStatus
 from clearbench.harness.run.spec import RunSpec
 from clearbench.harness.run.store import ResultsStore, RunRecord, machine_info, revision_info
@@ -104,11 +106,17 @@ class Runner:
         Show a tqdm progress bar on stderr.
     measure_timeout : float
         Wall-clock limit of the measuring phase [s].
+    environment : mapping of str to str, optional
+        Variables set in the workers' environment over this process's own (e.g.
+        ``{"NUMBA_CPU_NAME": "generic"}``; :func:`worker_environment`). None: the workers
+        inherit this process's environment unchanged.
     """
 
     def __init__(self, store: ResultsStore, jobs: int | None = None, runs_per_worker: int = 1,
-                 progress: bool = False, measure_timeout: float = MEASURE_TIMEOUT):
+                 progress: bool = False, measure_timeout: float = MEASURE_TIMEOUT,
+                 environment: Mapping[str, str] | None = None):
         self.store = store
+        self.environment = worker_environment(environment)
         self.jobs = max(1, int(jobs or default_jobs()))
         self.runs_per_worker = max(1, int(runs_per_worker))
         self.progress = progress
@@ -123,7 +131,8 @@ class Runner:
         parent_conn, child_conn = self._context.Pipe(duplex=True)
         process = self._context.Process(target=worker_main, args=(child_conn, os.getpid()),
                                         daemon=True, name="clearbench-worker")
-        process.start()
+        with _environment_set(self.environment):   # a spawned process copies os.environ
+            process.start()
         child_conn.close()
         return _Slot(process, parent_conn)
 
@@ -299,6 +308,34 @@ class Runner:
         outcome.records.append(record)
         LOG.info("%s: %s %s", spec.label, record.status, record.message)
         return record
+
+
+def worker_environment(overrides: Mapping[str, str] | None) -> dict[str, str]:
+    """The variables to set in a worker's environment for ``overrides``: those, plus a numba
+    cache directory of their own when they change numba's code generation (numba would
+    otherwise serve kernels compiled under other settings; :func:`clearbench.numba_cache_dir`),
+    unless the user chose the cache directory."""
+    environment = {str(name): str(value) for name, value in (overrides or {}).items()}
+    if (any(name in clearbench.NUMBA_CODEGEN_VARIABLES for name in environment)
+            and not clearbench.USER_NUMBA_CACHE_DIR and "NUMBA_CACHE_DIR" not in environment):
+        environment["NUMBA_CACHE_DIR"] = str(clearbench.numba_cache_dir(
+            {**os.environ, **environment}))
+    return environment
+
+
+@contextmanager
+def _environment_set(variables: Mapping[str, str]):
+    """``os.environ`` with ``variables`` set, restored on exit."""
+    saved = {name: os.environ.get(name) for name in variables}
+    os.environ.update(variables)
+    try:
+        yield
+    finally:
+        for name, value in saved.items():
+            if value is None:
+                os.environ.pop(name, None)
+            else:
+                os.environ[name] = value
 
 
 @dataclass
