@@ -18,6 +18,7 @@ from clearbench.harness.studies.regress import (
     updated_baseline,
     write_baseline,
 )
+from clearbench.harness.studies.regress.suite import warm_up
 
 
 def register(subparsers) -> None:
@@ -64,6 +65,7 @@ def run_regress(args: argparse.Namespace) -> int:
         raise UserError("--jobs and --runs-per-worker must be >= 1")
     if args.update:
         return _update(args, baseline, entries, specs, skipped, modules, start)
+    warm_up(entries, modules)
     results = run_suite(specs, jobs=args.jobs, runs_per_worker=args.runs_per_worker)
     elapsed = time.monotonic() - start
     outcome = compare(baseline, results, skipped)

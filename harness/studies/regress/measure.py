@@ -21,7 +21,7 @@ from clearbench.harness.studies.regress.perturbations import (
     perturb_initial_state,
     variants_for,
 )
-from clearbench.harness.studies.regress.suite import engine_name, entry_spec, run_suite
+from clearbench.harness.studies.regress.suite import engine_name, entry_spec, run_suite, warm_up
 from clearbench.harness.studies.regress.tolerance import classify, figure_scale
 
 #: Engines whose runs the environment perturbations (numba, OpenBLAS) reach: the reference
@@ -77,6 +77,9 @@ def run_perturbed(entries: Mapping[str, dict], plan: Mapping[str, list[Variant]]
         if on_group is not None:
             label = " ".join(f"{k}={v}" for k, v in environment) or "round-off and options"
             on_group(label, len(specs))
+        if environment:
+            warm_up({ident: entries[ident] for ident, _ in specs}, extra_modules,
+                    dict(environment))
         keyed = {f"{ident}\x00{name}": spec for (ident, name), spec in specs.items()}
         ran = run_suite(keyed, jobs=jobs, runs_per_worker=runs_per_worker,
                         environment=dict(environment))
@@ -142,6 +145,7 @@ def measure_baseline(entries: Mapping[str, dict], specs: Mapping[str, RunSpec],
     start = time.monotonic()
     if on_group is not None:
         on_group("as given", len(specs))
+    warm_up(entries, extra_modules)
     results = run_suite(specs, jobs=jobs, runs_per_worker=runs_per_worker)
     plan = planned_variants(entries, perturbations)
     perturbed = run_perturbed(entries, plan, extra_modules, jobs, runs_per_worker, on_group)

@@ -157,6 +157,43 @@ def _result_of(row: dict) -> dict:
             "worker_seconds": float(row.get("worker_seconds") or 0.0)}
 
 
+#: Wall-clock limit of a warm-up run [s]: it may compile every numba kernel of the reference
+#: solver and of the measuring code from an empty cache (minutes on a loaded 2-core machine).
+WARM_UP_TIMEOUT = 3600.0
+#: Engines whose runs compile numba kernels (the measuring code's are compiled by them too).
+NUMBA_ENGINES = ("reference",)
+
+
+def warm_up_specs(entries: Mapping[str, dict],
+                  extra_modules: Mapping[str, str] | None = None) -> list[RunSpec]:
+    """One run of two steps per distinct scene of the entries of :data:`NUMBA_ENGINES`, with a
+    long wall-clock limit: run one after the other before a suite, they fill numba's cache,
+    so that the suite's runs (each in a fresh worker, with the entry's own limit) do not all
+    compile the same kernels at once from an empty cache and time out."""
+    specs = {}
+    for ident, entry in entries.items():
+        if engine_name(entry.get("engine")) not in NUMBA_ENGINES:
+            continue
+        key = json.dumps([entry["scene"], entry.get("parameters")], sort_keys=True)
+        if key in specs:
+            continue
+        spec = entry_spec(entry, ident, extra_modules)
+        specs[key] = entry_spec({**entry, "horizon": 2 * spec.time_step,
+                                 "timeout": WARM_UP_TIMEOUT}, ident, extra_modules)
+    return list(specs.values())
+
+
+def warm_up(entries: Mapping[str, dict], extra_modules: Mapping[str, str] | None = None,
+            environment: Mapping[str, str] | None = None) -> None:
+    """Run :func:`warm_up_specs` one after the other in one worker (results discarded)."""
+    specs = warm_up_specs(entries, extra_modules)
+    if not specs:
+        return
+    with tempfile.TemporaryDirectory(prefix="clearbench-warm-") as scratch:
+        Runner(ResultsStore(scratch), jobs=1, runs_per_worker=len(specs),
+               environment=environment).run_all(specs, rerun=True)
+
+
 def run_suite(specs: Mapping[str, RunSpec], store_dir: str | Path | None = None,
               jobs: int | None = None, runs_per_worker: int = 1, progress: bool = False,
               environment: Mapping[str, str] | None = None) -> dict[str, dict]:
