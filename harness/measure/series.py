@@ -22,17 +22,14 @@ from clearbench.kernels.quaternion import (
     quat_to_matrix_batch,
 )
 from clearbench.scenarios.bodies import Motion
+from clearbench.scenarios.features import LOAD_FEATURES, WORK_FEATURES
 from clearbench.scenarios.geometry import (
     contacts_between,
     enclosing_ring_gap,
     ring_encloses_axis,
 )
 from clearbench.scenarios.loads import (
-    AngleLawLoad,
-    DistanceLawLoad,
     LinearSpringDamper,
-    Moment,
-    PointForce,
     TorsionalSpringDamper,
 )
 from clearbench.scenarios.outputs import BodyAngle, ContactForce, PointDistance, PointPosition
@@ -440,10 +437,17 @@ def energy(scene: Scene, trajectory: Trajectory) -> Energy:
 
 
 def non_conservative_loads(scene: Scene) -> tuple[str, ...]:
-    """Names of the loads whose work :func:`energy` cannot count (law loads, time-switched
-    forces and moments): an energy expectation is meaningless while they act."""
-    return tuple(load.name for load in scene.loads
-                 if isinstance(load, AngleLawLoad | DistanceLawLoad | PointForce | Moment))
+    """Names of the loads whose work :func:`energy` cannot count (those of the
+    :data:`~clearbench.scenarios.features.WORK_FEATURES`: law loads, point forces and moments):
+    an energy expectation is meaningless while they act."""
+    return tuple(load.name for load in scene.loads if LOAD_FEATURES[load.kind] in WORK_FEATURES)
+
+
+def energy_balance_applies(scene: Scene) -> bool:
+    """True when :func:`energy` counts every energy the scene exchanges: no driver, point
+    force, moment or law load (:data:`~clearbench.scenarios.features.WORK_FEATURES`). Then the
+    energy may only decrease (friction, dampers and restitution e <= 1 dissipate)."""
+    return not scene.features & set(WORK_FEATURES)
 
 
 def relative_angle(trajectory: Trajectory, body_a: int, body_b: int, axis) -> np.ndarray:
