@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from clearbench.scenarios.bodies import Motion
+from clearbench.scenarios.features import WORK_FEATURES
 from clearbench.scenarios.scales import largest_shape_dimension
 from clearbench.scenarios.scene import Scene
 
@@ -18,8 +19,8 @@ __all__ = ["ENERGY_EXPECTATIONS", "SPRING_WORK_FEATURES", "WORK_FEATURES", "Ener
 
 #: Expectation kinds under which the energy of the scene may not grow.
 ENERGY_EXPECTATIONS = ("energy_non_increasing", "energy_conserved")
-#: Features that do work an engine's energy bookkeeping does not count (the guard stays off).
-WORK_FEATURES = ("drivers", "point_forces", "moments", "angle_law_loads", "distance_law_loads")
+# WORK_FEATURES (scenarios.features): features doing work an energy balance does not count
+# (the guard stays off).
 #: The same plus torsional springs, for engines whose energy counts linear springs only.
 SPRING_WORK_FEATURES = (*WORK_FEATURES, "torsional_springs")
 

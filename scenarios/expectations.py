@@ -24,18 +24,29 @@ from clearbench.scenarios.validation import (
     check_finite,
 )
 
+#: Marks a parameter whose dimension is that of the expectation's output
+#: (``output_value``): the scene converts it with the output's unit (Scene.rescaled).
+OUTPUT_DIMENSION = "output"
+
 
 @dataclass(frozen=True)
 class ExpectationKind:
-    """Parameters (name -> dimension) and the statement checked."""
+    """Parameters (name -> dimension, or :data:`OUTPUT_DIMENSION`) and the statement
+    checked; ``optional`` parameters may be left out, and at least one of each group in
+    ``one_of`` must be given."""
 
     parameters: MappingProxyType
     statement: str
     needs_body: bool = True
+    optional: frozenset = frozenset()
+    one_of: tuple = ()
+    needs_output: bool = False
 
 
-def _kind(statement: str, needs_body: bool = True, **parameters) -> ExpectationKind:
-    return ExpectationKind(MappingProxyType(parameters), statement, needs_body)
+def _kind(statement: str, needs_body: bool = True, optional=(), one_of=(),
+          needs_output: bool = False, **parameters) -> ExpectationKind:
+    return ExpectationKind(MappingProxyType(parameters), statement, needs_body,
+                           frozenset(optional), tuple(one_of), needs_output)
 
 
 EXPECTATION_KINDS: dict[str, ExpectationKind] = {
@@ -54,6 +65,11 @@ EXPECTATION_KINDS: dict[str, ExpectationKind] = {
     "sliding_stop": _kind(
         "stops after v0/(mu g), at distance v0^2/(2 mu g), then sticks",
         initial_speed=VELOCITY, friction=DIMENSIONLESS, gravity=ACCELERATION,
+    ),
+    "rolling_incline": _kind(
+        "rolls down the incline without slipping: distance a t^2 / 2 with "
+        "a = g sin(angle) / (1 + I/(m r^2)) (I about the rolling axis), contact point at rest",
+        angle=DIMENSIONLESS, gravity=ACCELERATION, radius=LENGTH,
     ),
     "rolling_transition": _kind(
         "rolls without slip from t = 2 v0/(7 mu g) at speed 5 v0/7",
@@ -87,18 +103,30 @@ EXPECTATION_KINDS: dict[str, ExpectationKind] = {
     "energy_non_increasing": _kind("total mechanical energy never grows", needs_body=False),
     "energy_conserved": _kind("total mechanical energy is conserved", needs_body=False),
     "no_penetration": _kind("no contact gap below zero", needs_body=False),
+    "output_value": _kind(
+        "the named output equals value at time (the end if no time) within absolute_tolerance"
+        " + relative_tolerance x |value| (either or both; value and absolute_tolerance in the "
+        "output's unit)",
+        needs_body=False, needs_output=True,
+        optional=("time", "absolute_tolerance", "relative_tolerance"),
+        one_of=(("absolute_tolerance", "relative_tolerance"),),
+        value=OUTPUT_DIMENSION, absolute_tolerance=OUTPUT_DIMENSION,
+        relative_tolerance=DIMENSIONLESS, time=TIME,
+    ),
 }
 
 
 @dataclass(frozen=True)
 class Expectation(Element):
-    """An expectation of ``kind`` about ``body`` with ``parameters`` (name -> value, in the
-    scene's units; dimensions fixed by the kind)."""
+    """An expectation of ``kind`` about ``body`` (or the named ``output``, for
+    ``output_value``) with ``parameters`` (name -> value, in the scene's units; dimensions
+    fixed by the kind)."""
 
     collection = "expectations"
     kind: str = ""
     body: str | None = None
     parameters: MappingProxyType = field(default_factory=lambda: MappingProxyType({}))
+    output: str | None = None
 
     def _validate(self) -> None:
         if self.kind not in EXPECTATION_KINDS:
@@ -106,16 +134,28 @@ class Expectation(Element):
         spec = EXPECTATION_KINDS[self.kind]
         if spec.needs_body and not self.body:
             raise SceneError("body", self.body, f"expectation {self.kind!r} needs a body")
+        if spec.needs_output and not self.output:
+            raise SceneError("output", self.output,
+                             f"expectation {self.kind!r} needs the name of an [[outputs]] entry")
+        if self.output is not None and not spec.needs_output:
+            raise SceneError("output", self.output, f"expectation {self.kind!r} takes no output")
         given = dict(self.parameters)
-        missing = sorted(set(spec.parameters) - set(given))
+        missing = sorted(set(spec.parameters) - spec.optional - set(given))
         unknown = sorted(set(given) - set(spec.parameters))
         if missing:
             raise SceneError("parameters", given, f"missing {missing} for {self.kind!r}")
         if unknown:
             raise SceneError("parameters", given, f"unknown {unknown} for {self.kind!r}")
+        for group in spec.one_of:
+            if not set(group) & set(given):
+                raise SceneError("parameters", given,
+                                 f"{self.kind!r} needs at least one of {list(group)}")
         for key, value in given.items():
             check_finite(f"parameters.{key}", value)
-        self._set("parameters", MappingProxyType({k: float(given[k]) for k in spec.parameters}))
+            if key.endswith("tolerance") and float(value) < 0:
+                raise SceneError(f"parameters.{key}", value, "must be >= 0")
+        self._set("parameters", MappingProxyType({k: float(given[k]) for k in spec.parameters
+                                                  if k in given}))
 
     @property
     def statement(self) -> str:
@@ -124,8 +164,13 @@ class Expectation(Element):
     def field_dimension(self, name: str) -> dict | None:
         """Dimensions of the entries of ``parameters``."""
         if name == "parameters":
-            return dict(EXPECTATION_KINDS[self.kind].parameters)
+            # Parameters in the output's unit are converted by the scene (Scene.rescaled),
+            # which knows the output: here they are left as they are.
+            return {key: (DIMENSIONLESS if dimension == OUTPUT_DIMENSION else dimension)
+                    for key, dimension in EXPECTATION_KINDS[self.kind].parameters.items()
+                    if key in self.parameters}
         return None
 
     def __hash__(self) -> int:
-        return hash((self.name, self.kind, self.body, tuple(self.parameters.items())))
+        return hash((self.name, self.kind, self.body, tuple(self.parameters.items()),
+                     self.output))

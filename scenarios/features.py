@@ -28,6 +28,15 @@ LOAD_FEATURES = {
     "angle_law": "angle_law_loads", "distance_law": "distance_law_loads",
 }
 
+#: Features whose work no energy balance counts: a driver's prescribed motion, point forces
+#: and moments (time-switched or not), and law loads (their forces are not the gradient of a
+#: potential in general: a torsion law applied as a force on a body-fixed lever, a distance
+#: law pushing along a body axis). Where none is present the scene conserves or dissipates
+#: energy (gravity and springs store it, friction, dampers and restitution e <= 1 only take it),
+#: so any gain is the engine's. The one list for the harness's energy figures and verdict and
+#: the engines' energy guard.
+WORK_FEATURES = ("drivers", "point_forces", "moments", "angle_law_loads", "distance_law_loads")
+
 
 class FeatureKind(enum.Enum):
     """What a feature names: a plain capability, a shape kind, a joint kind, a shape pair."""

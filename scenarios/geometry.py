@@ -150,6 +150,8 @@ from clearbench.kernels.gaps import (
     SHAPE_KIND_NAMES,
     SPHERE,
     SUPPORTED,
+    axis_crosses_inside_ring,
+    enclosing_ring_gap,
     pair_contacts,
 )
 from clearbench.kernels.quaternion import quat_multiply, quat_normalize, quat_to_matrix
@@ -179,6 +181,8 @@ __all__ = [
     "contact_frame",
     "contact_frames_batch",
     "contacts_between",
+    "enclosing_ring_gap",
+    "ring_encloses_axis",
     "frame_tangent",
     "kind_name",
     "pack_shape_parameters",
@@ -401,3 +405,22 @@ def contacts_between(shape_a: Shape, pose_a, shape_b: Shape, pose_b) -> PairCont
     for array in arrays:
         array.setflags(write=False)
     return PairContacts(*arrays)
+
+
+def ring_encloses_axis(shape_a: Shape, pose_a, shape_b: Shape, pose_b) -> bool | None:
+    """For a ring (circle or arc) against a cylinder, in either order: True when the cylinder's
+    axis crosses the ring's plane inside the ring (a journal in its bore:
+    :func:`~clearbench.kernels.gaps.axis_crosses_inside_ring`), False when outside; None for
+    any other pair. Poses as in :func:`contacts_between`."""
+    kinds = {shape_a.kind, shape_b.kind}
+    if "cylinder" not in kinds or not kinds & {"circle", "arc"}:
+        return None
+    (ring, ring_pose), (cylinder, cylinder_pose) = sorted(
+        ((shape_a, pose_a), (shape_b, pose_b)), key=lambda item: item[0].kind == "cylinder")
+    ring_position, ring_rotation = shape_world_placement(ring, *ring_pose)
+    axis_point, axis_rotation = shape_world_placement(cylinder, *cylinder_pose)
+    start, span = 0.0, 2.0 * np.pi
+    if ring.kind == "arc":
+        start, span = ring.start_angle, ring.end_angle - ring.start_angle
+    return axis_crosses_inside_ring(ring_position, ring_rotation, ring.radius, start, span,
+                                    axis_point, axis_rotation[:, 2])

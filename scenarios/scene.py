@@ -19,7 +19,11 @@ from clearbench.scenarios.bodies import Body, Motion
 from clearbench.scenarios.contacts import ContactPair
 from clearbench.scenarios.dict_form import scene_to_dict
 from clearbench.scenarios.drivers import Driver
-from clearbench.scenarios.expectations import Expectation
+from clearbench.scenarios.expectations import (
+    EXPECTATION_KINDS,
+    OUTPUT_DIMENSION,
+    Expectation,
+)
 from clearbench.scenarios.features import (
     LOAD_FEATURES,
     joint_feature,
@@ -183,9 +187,13 @@ class Scene:
             for attribute in ("body", "body_a", "body_b"):
                 if hasattr(output, attribute):
                     self._body_or_error(f"{path}.{attribute}", getattr(output, attribute))
+        output_names = {output.name for output in self.outputs}
         for expectation in self.expectations:
             if expectation.body is not None:
                 self._body_or_error(f"expectations[{expectation.name!r}].body", expectation.body)
+            if expectation.output is not None and expectation.output not in output_names:
+                raise SceneError(f"expectations[{expectation.name!r}].output", expectation.output,
+                                 f"unknown output; outputs: {sorted(output_names)}")
 
     # ------------------------------------------------------------------ access
     def body(self, name: str) -> Body:
@@ -308,7 +316,21 @@ class Scene:
 
     def rescaled(self, units: UnitSystem) -> Scene:
         """The same physics expressed in ``units`` (every dimensioned value converted)."""
-        return rescale_element(self, self.units, units)
+        scene = rescale_element(self, self.units, units)
+        dimensions = {output.name: output.dimension for output in self.outputs}
+        converted = []
+        for expectation in scene.expectations:
+            spec = EXPECTATION_KINDS[expectation.kind]
+            in_output_unit = [k for k in expectation.parameters
+                              if spec.parameters[k] == OUTPUT_DIMENSION]
+            if in_output_unit:
+                factor = self.units.factor_to(units, dimensions[expectation.output])
+                parameters = dict(expectation.parameters)
+                for key in in_output_unit:
+                    parameters[key] *= factor
+                expectation = dataclasses.replace(expectation, parameters=parameters)
+            converted.append(expectation)
+        return dataclasses.replace(scene, expectations=tuple(converted))
 
     @cached_property
     def content_hash(self) -> str:

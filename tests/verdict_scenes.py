@@ -82,3 +82,39 @@ def pulled_apart_linkage(pull_speed: float = 0.5, crank_length: float = 0.1,
                  Driver("pull", body="slider", component="x", times=(0.0,),
                         values=(pull_speed,))),
     )
+
+
+def branched_tree(arm: float = 0.2) -> Scene:
+    """A branched pendulum tree hung from the ground, its bodies listed so that the tree is
+    not depth-first: ``hub`` (revolute to the ground about y), ``left`` and ``right`` (each
+    revolute to the hub), and ``tip`` (revolute to ``left``), listed hub, left, right, tip. A
+    breadth-first plan makes links hub, left, right, tip; a depth-first numbering hub, left,
+    tip, right. Every body has its own mass (0.1 to 0.4 kg), so bodies in the wrong rows show
+    in every figure. Starts at rest, tilted by the arms' layout, swings in gravity (no contact).
+    Lengths in m."""
+    def rod(name: str, mass: float, position: tuple) -> Body:
+        # A slender rod along x of length ``arm``, its frame at its centre of mass.
+        return Body(name, mass=mass, inertia=diagonal(1e-6, mass * arm**2 / 12,
+                                                      mass * arm**2 / 12),
+                    position=position)
+
+    y_axis = (0.0, 1.0, 0.0)
+    hub = rod("hub", 0.4, (0.5 * arm, 0.0, 0.0))
+    left = rod("left", 0.1, (1.5 * arm, 0.0, 0.0))
+    right = rod("right", 0.3, (arm, 0.0, -0.5 * arm))
+    tip = rod("tip", 0.2, (2.5 * arm, 0.0, 0.0))
+    return Scene(
+        name="branched-tree",
+        description="A branched pendulum tree listed breadth-first (hub, left, right, tip).",
+        gravity=(0.0, 0.0, -GRAVITY), horizon=0.2, time_step=1e-3,
+        bodies=(Body("ground", motion=Motion.FIXED), hub, left, right, tip),
+        joints=(
+            RevoluteJoint("pivot", body_a="ground", body_b="hub", axis=y_axis),
+            RevoluteJoint("hub_left", body_a="hub", body_b="left", anchor=(arm, 0.0, 0.0),
+                          axis=y_axis),
+            RevoluteJoint("hub_right", body_a="hub", body_b="right", anchor=(arm, 0.0, 0.0),
+                          axis=y_axis),
+            RevoluteJoint("left_tip", body_a="left", body_b="tip",
+                          anchor=(2.0 * arm, 0.0, 0.0), axis=y_axis),
+        ),
+    )

@@ -253,7 +253,7 @@ def _build_tree(client, scene, settings, tree: TreePlan, topology, body_poses, g
     frames: dict[int, tuple] = {0: (np.zeros(3), IDENTITY.copy())}  # pb parent index -> pose
     link_of: dict[str, int] = {}   # scene body -> pb parent index of its mass link (0: base)
     pending = []                    # (body name, link index, kind, joint, moments, inertial)
-    registered_joints = []          # (pb link index, kind, link plan, slide axis)
+    registered_joints = []          # (creation link index, kind, link plan, slide axis)
 
     base_mass, base_inertial, base_frame = 0.0, (np.zeros(3), IDENTITY.copy()), frames[0]
     links = list(tree.links)
@@ -336,6 +336,13 @@ def _build_tree(client, scene, settings, tree: TreePlan, topology, body_poses, g
         linkInertialFrameOrientations=inertial_orientations, linkParentIndices=parents,
         linkJointTypes=types, linkJointAxis=axes, useMaximalCoordinates=False,
         physicsClientId=client)
+    # PyBullet renumbers the links depth-first: every index planned above is a creation index.
+    index_of = _link_indices(client, uid)
+    pending = [(name, index_of[k], moments, inertial) for name, k, moments, inertial in pending]
+    collision_links = [(pair, side, name, index_of[k], group, shape)
+                       for pair, side, name, k, group, shape in collision_links]
+    registered_joints = [(index_of[k], kind, link, axis)
+                         for k, kind, link, axis in registered_joints]
     for name, link_index, moments, inertial in pending:
         body = expanded.body(name)
         pb.changeDynamics(uid, link_index, mass=body.mass, localInertiaDiagonal=list(moments),
@@ -363,6 +370,24 @@ def _build_tree(client, scene, settings, tree: TreePlan, topology, body_poses, g
         scale = weight * (size if dof.driver.is_rotation else 1.0)
         driven.append(DrivenJoint(uid, joint_index, dof.sign, dof.driver,
                                   settings.driver_max_force * scale))
+
+
+def _link_indices(client: int, uid: int) -> dict[int, int]:
+    """Creation index (0-based position in ``createMultiBody``'s link lists; -1 the base) ->
+    PyBullet's link index.
+
+    ``createMultiBody`` renumbers the links depth-first (a branched tree listed breadth-first
+    comes back in another order) and names link k of the creation lists ``link{k + 1}``
+    (``getJointInfo`` field 12), which gives the map back.
+    """
+    index_of = {-1: -1}
+    for index in range(pb.getNumJoints(uid, physicsClientId=client)):
+        name = pb.getJointInfo(uid, index, physicsClientId=client)[12].decode()
+        if not name.startswith("link") or not name[4:].isdigit():
+            raise RuntimeError(f"PyBullet link {index} has an unexpected name {name!r}: cannot "
+                               "map it back to the link it was created as")
+        index_of[int(name[4:]) - 1] = index
+    return index_of
 
 
 def _com_frame(handle: BodyHandle, body_pose: tuple) -> tuple:

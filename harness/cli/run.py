@@ -101,8 +101,8 @@ def print_summary(row: dict, from_store: bool = False, store_path=None) -> None:
         print("  expectations:")
         for result in expectations:
             passed = result.get("passed")
-            mark = {True: "pass", False: "FAIL", None: "n/a"}.get(passed, str(passed))
-            detail = result.get("message") or result.get("statement") or ""
+            mark = {True: "PASS", False: "FAIL", None: "n/a"}.get(passed, str(passed))
+            detail = result.get("detail") or result.get("criterion") or result.get("note", "")
             print(f"    {mark:<5} {result.get('name', result.get('kind', '?'))}: {detail}")
     if row["metrics_error"]:
         print(f"  metrics not computed: {row['metrics_error']}")

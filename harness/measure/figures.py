@@ -56,10 +56,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from clearbench.adapters.energy_guard import ENERGY_EXPECTATIONS
 from clearbench.adapters.trajectory import RunStatus, Trajectory
 from clearbench.harness.measure import series as metrics
-from clearbench.harness.measure.expectation_figures import evaluate
-from clearbench.harness.measure.verdicts import ANALYTIC_ERROR, analytic_error, judge
+from clearbench.harness.measure.expectation_figures import ExpectationResult, evaluate
+from clearbench.harness.measure.verdicts import ANALYTIC_ERROR, analytic_error, judgement
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.scales import contact_feature_sizes, scene_size
 from clearbench.scenarios.scene import Scene
@@ -84,8 +85,6 @@ JOINT_BREAK_FRACTION = 0.05
 JOINT_BREAK_ANGLE = 0.1
 #: Expectation kinds whose body must not move.
 STICK_KINDS = frozenset({"incline_stick", "sticks"})
-#: Features whose loads do work the energy balance does not count.
-WORKING_FEATURES = frozenset({"drivers", "point_forces", "moments"})
 
 
 @dataclass(frozen=True)
@@ -123,17 +122,23 @@ def first_non_finite(trajectory: Trajectory) -> str | None:
 
 
 def _expectation_results(scene: Scene, trajectory: Trajectory, out: _Collector):
-    """Every expectation's figures (also flattened into ``NAME.FIGURE`` figures), pass/fail
-    and criterion (:mod:`.verdicts`), and the analytic error with its source."""
-    bodies = {e.name: e.body for e in scene.expectations}
+    """Every expectation's figures (also flattened into ``NAME.FIGURE`` figures), pass/fail,
+    criterion and detail (:mod:`.verdicts`), the implied energy balance check
+    (:func:`_energy_balance_result`), and the analytic error with its source."""
+    expectations = {e.name: e for e in scene.expectations}
     results = []
     errors = []
-    for result in evaluate(scene, trajectory):
+    evaluated = evaluate(scene, trajectory)
+    implied = _energy_balance_result(scene, out)
+    for result in evaluated + ([implied] if implied is not None else []):
         figures = {k: float(v) for k, v in result.figures.items()}
-        passed, criterion = judge(scene, result.kind, bodies.get(result.name), figures)
+        expectation = expectations.get(result.name)
+        verdict = judgement(scene, result.kind, expectation.body if expectation else None,
+                            figures, result.where, expectation)
         results.append({"name": result.name, "kind": result.kind, "figures": figures,
-                        "headline": result.headline, "note": result.note, "passed": passed,
-                        "criterion": criterion})
+                        "headline": result.headline, "note": result.note,
+                        "passed": verdict.passed, "criterion": verdict.criterion,
+                        "detail": verdict.detail})
         for key, value in figures.items():
             out.put(f"{result.name}.{key}", value)
         error = analytic_error(result.kind, figures)
@@ -143,6 +148,25 @@ def _expectation_results(scene: Scene, trajectory: Trajectory, out: _Collector):
         return results, math.nan, ""
     value, name = max(errors)
     return results, value, f"analytic ({name})"
+
+
+#: Name of the implied expectation every run gets where the scene's energy balance is
+#: computed and the scene lists no energy expectation of its own.
+ENERGY_BALANCE = "energy_balance"
+
+
+def _energy_balance_result(scene: Scene, out: _Collector) -> ExpectationResult | None:
+    """The energy check every run gets when the energy balance is computed (no driver, point
+    force, moment or law load: ``energy_growth`` was measured) and the scene lists no energy
+    expectation: restitution e <= 1, friction and dampers only take energy, so a growth
+    beyond :data:`~.verdicts.ENERGY_GROWTH_ALLOWANCE` of the energy scale is wrong physics,
+    whatever the scene asks."""
+    growth = out.figures.get("energy_growth")
+    if growth is None or any(e.kind in ENERGY_EXPECTATIONS for e in scene.expectations):
+        return None
+    return ExpectationResult(ENERGY_BALANCE, ENERGY_BALANCE,
+                             {"energy_growth_relative": growth}, "energy_growth_relative",
+                             "implied: the scene's energy balance is computed")
 
 
 class _Collector:
@@ -309,7 +333,7 @@ def _stiction(scene, trajectory, out: _Collector) -> None:
 
 
 def _energy(scene, trajectory, out: _Collector, reasons: list[str]) -> None:
-    if scene.features & WORKING_FEATURES:
+    if not metrics.energy_balance_applies(scene):
         return
     energy = metrics.energy(scene, trajectory)
     total = energy.total
@@ -321,8 +345,7 @@ def _energy(scene, trajectory, out: _Collector, reasons: list[str]) -> None:
     out.put("energy_growth", growth)
     free_rise, free_scale = metrics.energy_growth_contact_free(scene, trajectory, energy)
     out.put("energy_growth_contact_free", free_rise / free_scale)
-    must_not_grow = any(e.kind in ("energy_non_increasing", "energy_conserved")
-                        for e in scene.expectations)
+    must_not_grow = any(e.kind in ENERGY_EXPECTATIONS for e in scene.expectations)
     if must_not_grow and growth > ENERGY_GROWTH_LIMIT:
         reasons.append(f"energy grew by {100 * growth:.3g} % of its scale {rise_scale:.3g} "
                        "(energy that may not grow)")

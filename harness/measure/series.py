@@ -22,13 +22,14 @@ from clearbench.kernels.quaternion import (
     quat_to_matrix_batch,
 )
 from clearbench.scenarios.bodies import Motion
-from clearbench.scenarios.geometry import contacts_between
+from clearbench.scenarios.features import LOAD_FEATURES, WORK_FEATURES
+from clearbench.scenarios.geometry import (
+    contacts_between,
+    enclosing_ring_gap,
+    ring_encloses_axis,
+)
 from clearbench.scenarios.loads import (
-    AngleLawLoad,
-    DistanceLawLoad,
     LinearSpringDamper,
-    Moment,
-    PointForce,
     TorsionalSpringDamper,
 )
 from clearbench.scenarios.outputs import BodyAngle, ContactForce, PointDistance, PointPosition
@@ -53,20 +54,34 @@ _LAST_GAPS: list = [None, None, None]
 
 def _pair_shapes(scene: Scene):
     """Per contact pair of ``scene.expanded``: (contact, body index A, shape A, body index B,
-    shape B)."""
+    shape B, encloses). ``encloses`` is True for a ring around a journal (a bearing ring of a
+    clearance joint, a C-60 ring on its pin): at the scene's initial configuration the
+    cylinder's axis crosses the ring inside it (:func:`ring_encloses_axis`)."""
     expanded = scene.expanded
     index = {b.name: i for i, b in enumerate(expanded.bodies)}
     for contact in expanded.contacts:
         a, b = index[contact.body_a], index[contact.body_b]
-        yield (contact, a, expanded.bodies[a].shape(contact.shape_a),
-               b, expanded.bodies[b].shape(contact.shape_b))
+        body_a, body_b = expanded.bodies[a], expanded.bodies[b]
+        shape_a, shape_b = body_a.shape(contact.shape_a), body_b.shape(contact.shape_b)
+        encloses = ring_encloses_axis(shape_a, (body_a.position, body_a.orientation),
+                                      shape_b, (body_b.position, body_b.orientation))
+        yield contact, a, shape_a, b, shape_b, bool(encloses)
 
 
-def _smallest_gap(contact, shape_a, pose_a, shape_b, pose_b) -> float:
+def _smallest_gap(contact, shape_a, pose_a, shape_b, pose_b, encloses: bool = False) -> float:
     """Smallest gap of one pair at one configuration minus its offset [L]; inf without a
-    candidate."""
+    candidate. A ring that must enclose its journal (``encloses``) counts a journal beyond the
+    ring as through its wall (:func:`enclosing_ring_gap`): the gap keeps decreasing with the
+    distance instead of turning positive again."""
     result = contacts_between(shape_a, pose_a, shape_b, pose_b)
-    return float(np.min(result.gap)) - contact.offset if len(result.gap) else math.inf
+    if not len(result.gap):
+        return math.inf
+    gap = float(np.min(result.gap))
+    if encloses:
+        cylinder = shape_a if shape_a.kind == "cylinder" else shape_b
+        gap = enclosing_ring_gap(gap, cylinder.radius,
+                                 ring_encloses_axis(shape_a, pose_a, shape_b, pose_b))
+    return gap - contact.offset
 
 
 def contact_gaps(scene: Scene, trajectory: Trajectory) -> np.ndarray:
@@ -76,11 +91,12 @@ def contact_gaps(scene: Scene, trajectory: Trajectory) -> np.ndarray:
     if _LAST_GAPS[0] is scene and _LAST_GAPS[1] is trajectory:
         return _LAST_GAPS[2]
     out = np.full((len(trajectory.times), len(scene.expanded.contacts)), np.inf)
-    for k, (contact, a, shape_a, b, shape_b) in enumerate(_pair_shapes(scene)):
+    for k, (contact, a, shape_a, b, shape_b, encloses) in enumerate(_pair_shapes(scene)):
         xa, qa = _poses(trajectory, a)
         xb, qb = _poses(trajectory, b)
         for t in range(len(trajectory.times)):
-            out[t, k] = _smallest_gap(contact, shape_a, (xa[t], qa[t]), shape_b, (xb[t], qb[t]))
+            out[t, k] = _smallest_gap(contact, shape_a, (xa[t], qa[t]), shape_b, (xb[t], qb[t]),
+                                      encloses)
     out.flags.writeable = False
     _LAST_GAPS[:] = [scene, trajectory, out]
     return out
@@ -140,7 +156,7 @@ def swept_penetration(scene: Scene, trajectory: Trajectory) -> np.ndarray:
     local_coms = [np.asarray(b.center_of_mass, dtype=float) for b in expanded.bodies]
     coms = trajectory.positions + quat_rotate_batch(
         q, np.broadcast_to(np.array(local_coms), q.shape[:-1] + (3,)))
-    for k, (contact, a, shape_a, b, shape_b) in enumerate(_pair_shapes(scene)):
+    for k, (contact, a, shape_a, b, shape_b, encloses) in enumerate(_pair_shapes(scene)):
         feature = float(features[k])
         if not math.isfinite(feature) or feature <= 0.0:
             continue
@@ -159,7 +175,7 @@ def swept_penetration(scene: Scene, trajectory: Trajectory) -> np.ndarray:
                                             local_coms[a], s)
                 pose_b = _interpolated_pose(coms[i, b], coms[i + 1, b], q[i, b], q[i + 1, b],
                                             local_coms[b], s)
-                gap = _smallest_gap(contact, shape_a, pose_a, shape_b, pose_b)
+                gap = _smallest_gap(contact, shape_a, pose_a, shape_b, pose_b, encloses)
                 if math.isfinite(gap):
                     out[k] = max(out[k], -gap)
     return out
@@ -173,8 +189,8 @@ def penetration(scene: Scene, trajectory: Trajectory) -> np.ndarray:
 
 @dataclass(frozen=True)
 class ClearanceMotion:
-    """Per clearance joint (T, nj): eccentricity of the bore centre from the journal axis at
-    each bearing ring (the larger of the two) and its excess over the radial clearance [L]."""
+    """Per clearance joint (T, nj): eccentricity of the journal in its bore at each bearing
+    ring (the larger of the two) and its excess over the radial clearance [L]."""
 
     names: tuple
     eccentricity: np.ndarray
@@ -183,7 +199,12 @@ class ClearanceMotion:
 
 def clearance_motion(scene: Scene, trajectory: Trajectory) -> ClearanceMotion:
     """Eccentricity = radial clearance - (ring gap), evaluated with the shared ring-journal
-    gap, so that a tilted journal counts exactly; excess = max(0, eccentricity - clearance)."""
+    gap, so that a tilted journal counts exactly; excess = max(0, eccentricity - clearance).
+
+    With parallel axes the eccentricity is the distance of the journal axis from the bore
+    axis at the ring; the ring's gap is signed as a ring that must enclose its journal
+    (:func:`contact_gaps`), so the eccentricity is never negative and grows without bound as
+    the journal leaves the bore (it is not capped at the journal radius)."""
     names = tuple(j.name for j in scene.clearance_joints)
     if not names:
         empty = np.zeros((len(trajectory.times), 0))
@@ -210,7 +231,26 @@ class JointViolation:
     angle: np.ndarray
 
 
+def _in_body_frame(body, world_point=None, world_direction=None) -> np.ndarray:
+    """A world point or direction of the scene's initial configuration in ``body``'s frame
+    (the body's pose as the scene describes it, not as an engine returned it)."""
+    q = np.asarray(body.orientation, dtype=float)[None, :]
+    q = quat_conjugate_batch(quat_normalize_batch(q))
+    if world_point is not None:
+        vector = np.asarray(world_point, dtype=float) - np.asarray(body.position, dtype=float)
+    else:
+        vector = np.asarray(world_direction, dtype=float)
+    return quat_rotate_batch(q, vector[None, :])[0]
+
+
 def joint_violation(scene: Scene, trajectory: Trajectory) -> JointViolation:
+    """How far each ideal joint is from holding, on every sample.
+
+    The joint's frame on each body comes from the scene: the anchor (and axis) are world
+    values of the initial configuration, turned into each body's frame with the body's pose
+    in the scene. An engine that starts a body elsewhere than the scene says (a wrong
+    starting pose, bodies swapped) therefore shows as joint error from t = 0, where a frame
+    taken from the trajectory's own first sample would read zero."""
     names = tuple(j.name for j in scene.joints)
     count = len(trajectory.times)
     distance = np.zeros((count, len(names)))
@@ -218,32 +258,34 @@ def joint_violation(scene: Scene, trajectory: Trajectory) -> JointViolation:
     for j, joint in enumerate(scene.joints):
         a = scene.body_index(joint.body_a)
         b = scene.body_index(joint.body_b)
+        body_a, body_b = scene.bodies[a], scene.bodies[b]
         xa, qa = _poses(trajectory, a)
         xb, qb = _poses(trajectory, b)
-        qa0, qb0 = qa[0], qb[0]
-        anchor = np.asarray(joint.anchor, dtype=float)
-        local_a = quat_rotate_batch(quat_conjugate_batch(qa0), anchor - xa[0])
-        local_b = quat_rotate_batch(quat_conjugate_batch(qb0), anchor - xb[0])
+        local_a = np.broadcast_to(_in_body_frame(body_a, world_point=joint.anchor), (count, 3))
+        local_b = np.broadcast_to(_in_body_frame(body_b, world_point=joint.anchor), (count, 3))
         pa = xa + quat_rotate_batch(qa, local_a)
         pb = xb + quat_rotate_batch(qb, local_b)
+        axis = np.asarray(getattr(joint, "axis", (0.0, 0.0, 1.0)), dtype=float)
+        axis_a = quat_rotate_batch(qa, np.broadcast_to(
+            _in_body_frame(body_a, world_direction=axis), (count, 3)))
         if joint.kind != "prismatic":
             distance[:, j] = np.linalg.norm(pb - pa, axis=1)
         else:
-            axis_a = quat_rotate_batch(qa, quat_rotate_batch(quat_conjugate_batch(qa0),
-                                                             np.asarray(joint.axis)))
             d = pb - pa
             distance[:, j] = np.linalg.norm(d - np.sum(d * axis_a, axis=1)[:, None] * axis_a,
                                             axis=1)
         if joint.kind == "revolute":
-            axis = np.asarray(joint.axis, dtype=float)
-            axis_a = quat_rotate_batch(qa, quat_rotate_batch(quat_conjugate_batch(qa0), axis))
-            axis_b = quat_rotate_batch(qb, quat_rotate_batch(quat_conjugate_batch(qb0), axis))
+            axis_b = quat_rotate_batch(qb, np.broadcast_to(
+                _in_body_frame(body_b, world_direction=axis), (count, 3)))
             cross = np.linalg.norm(np.cross(axis_a, axis_b), axis=1)
             angle[:, j] = np.arctan2(cross, np.sum(axis_a * axis_b, axis=1))
         elif joint.kind in ("prismatic", "fixed"):
+            qa0 = quat_normalize_batch(np.asarray(body_a.orientation, dtype=float)[None, :])
+            qb0 = quat_normalize_batch(np.asarray(body_b.orientation, dtype=float)[None, :])
             relative0 = quat_multiply_batch(quat_conjugate_batch(qa0), qb0)
             relative = quat_multiply_batch(quat_conjugate_batch(qa), qb)
-            error = quat_multiply_batch(relative, quat_conjugate_batch(relative0))
+            error = quat_multiply_batch(relative, quat_conjugate_batch(
+                np.broadcast_to(relative0, relative.shape)))
             angle[:, j] = 2.0 * np.arctan2(np.linalg.norm(error[:, 1:], axis=1),
                                            np.abs(error[:, 0]))
     return JointViolation(names, distance, angle)
@@ -395,10 +437,17 @@ def energy(scene: Scene, trajectory: Trajectory) -> Energy:
 
 
 def non_conservative_loads(scene: Scene) -> tuple[str, ...]:
-    """Names of the loads whose work :func:`energy` cannot count (law loads, time-switched
-    forces and moments): an energy expectation is meaningless while they act."""
-    return tuple(load.name for load in scene.loads
-                 if isinstance(load, AngleLawLoad | DistanceLawLoad | PointForce | Moment))
+    """Names of the loads whose work :func:`energy` cannot count (those of the
+    :data:`~clearbench.scenarios.features.WORK_FEATURES`: law loads, point forces and moments):
+    an energy expectation is meaningless while they act."""
+    return tuple(load.name for load in scene.loads if LOAD_FEATURES[load.kind] in WORK_FEATURES)
+
+
+def energy_balance_applies(scene: Scene) -> bool:
+    """True when :func:`energy` counts every energy the scene exchanges: no driver, point
+    force, moment or law load (:data:`~clearbench.scenarios.features.WORK_FEATURES`). Then the
+    energy may only decrease (friction, dampers and restitution e <= 1 dissipate)."""
+    return not scene.features & set(WORK_FEATURES)
 
 
 def relative_angle(trajectory: Trajectory, body_a: int, body_b: int, axis) -> np.ndarray:

@@ -27,7 +27,10 @@ kind                        passes when
 bounce_apex                 every resolved apex within 5 % of e^(2k) h0
 incline_stick, sticks       displacement <= 1e-4 of the body's size
 incline_slide               acceleration within 2 % of g (sin - mu cos)
-sliding_stop                stop distance within 2 % of v0^2 / (2 mu g)
+sliding_stop                stop distance within 2 % of v0^2 / (2 mu g); stopped (speed
+                            <= 1e-3 v0) and slides <= 1e-4 of its size after the stop
+rolling_incline             distance within 2 % of a t^2 / 2, a = g sin / (1 + I/(m r^2));
+                            slip speed <= 1 % of the final speed a T
 rolling_transition          final speed within 2 % of 5 v0 / 7
 pendulum                    period within 1 % and energy drift <= 1 % of m g d
 torque_free                 angular momentum drift <= 1 % of |L0|
@@ -35,6 +38,9 @@ slider_crank                slider position within 1 % of the crank length
 rocking_ratio               first-impact ratio within 5 % of 1 - 1.5 sin^2(alpha)
 approaches_ideal            clearance excess <= one radial clearance
 energy_non_increasing       energy growth <= 1 % of the energy scale
+energy_balance              the same, on every run whose scene's energy balance is computed
+                            (no driver, point force, moment or law load): implied, not listed
+output_value                |y - expected| <= absolute + relative x |expected| tolerance
 energy_conserved            energy drift <= 1 % of the energy scale
 no_penetration              penetration <= 1 % of the smallest contact feature (radius,
                             half-extent or radial clearance)
@@ -59,6 +65,7 @@ ANALYTIC_ERROR: dict[str, tuple[tuple[str, str | None], ...]] = {
     "incline_slide": (("acceleration_relative_error", None),),
     "sliding_stop": (("stop_distance_error", "expected_stop_distance"),),
     "rolling_transition": (("final_speed_relative_error", None),),
+    "rolling_incline": (("distance_relative_error", None),),
     "pendulum": (("period_relative_error", None), ("energy_drift", None)),
     "torque_free": (("angular_momentum_drift", None),),
     "slider_crank": (("slider_position_relative_error", None),),
@@ -88,43 +95,185 @@ def _within(value, bound) -> bool | None:
     return abs(value) <= bound
 
 
+#: A failed physics verdict when the scene's energy balance can be computed and the energy
+#: grows by more than this fraction of its scale (the ``energy_balance`` check, and the
+#: criterion of the energy expectations). Restitution e <= 1, friction and dampers take
+#: energy, never give it, so the scene allows no growth: the allowance is the engine's
+#: numerical error plus the error of the contact-energy estimate of a compliant engine (half
+#: its normal force times the penetration, docs/harness.md "Energy"). Measured, a correct run
+#: stays 8 times below it (rigid engines: 1e-6 or less; the quick suite's compliant runs
+#: at most 0.12 %; the elastic ball row 0.14 % in mujoco[default]) and the smallest gain it
+#: must catch is 8 times above it (+8 % of PyBullet on the elastic row).
+ENERGY_GROWTH_ALLOWANCE = 0.01
+#: Criterion of the stick expectations, and of the stick after a ``sliding_stop``: the body
+#: moves by at most this fraction of its size.
+STICK_FRACTION = 1e-4
+#: ``rolling_incline``: slip speed of the contact point at most this fraction of the
+#: velocity scale (the analytic speed at the end). An exact engine has none (reference,
+#: Siconos: 1e-15 m/s); a soft or regularised friction slips by its creep: measured on
+#: ``rolling-incline`` (final speed 1.68 m/s, bound 16.8 mm/s) 3.4 mm/s in mujoco and
+#: pybullet, 4.5 mm/s in exudyn, 10 mm/s in exudyn[tuned], which also rolls 2.6 % too far
+#: (``clearbench run rolling-incline -e ENGINE``). A ball sliding without rolling slips at
+#: its whole speed.
+ROLLING_SLIP_FRACTION = 0.01
+
+
+@dataclass(frozen=True)
+class Judgement:
+    """Verdict of one expectation: ``passed`` (None when the figures allow none), the
+    ``criterion`` in words, and ``detail``: the measured figure against its bound, with
+    units and the place (``"0.639 mm > 0.1 mm (ball1-ball2)"``)."""
+
+    passed: bool | None
+    criterion: str
+    detail: str
+
+
+def _number(value: float) -> str:
+    return f"{value:.3g}"
+
+
+def _percent(name: str, value, bound: float) -> tuple[bool | None, str]:
+    """Relative figure ``value`` against ``bound``, both as fractions, worded in percent."""
+    passed = _within(value, bound)
+    if passed is None:
+        return None, f"{name} not measured"
+    sign = "<=" if passed else ">"
+    return passed, f"{name} {_number(100 * abs(value))} % {sign} {_number(100 * bound)} %"
+
+
+def _bounded(name: str, value, bound: float, unit: str) -> tuple[bool | None, str]:
+    """Figure ``value`` [unit] against ``bound`` [unit]."""
+    passed = _within(value, bound)
+    if passed is None:
+        return None, f"{name} not measured"
+    unit = f" {unit}" if unit else ""
+    sign = "<=" if passed else ">"
+    return passed, f"{name} {_number(abs(value))}{unit} {sign} {_number(bound)}{unit}"
+
+
+def _all(parts: list[tuple[bool | None, str]]) -> tuple[bool | None, str]:
+    """Every part must pass; a part not measured leaves the verdict to the others."""
+    verdicts = [p for p, _ in parts if p is not None]
+    passed = (all(verdicts) if verdicts else None)
+    return passed, "; ".join(text for _, text in parts)
+
+
 def judge(scene: Scene, kind: str, body: str | None, figures: dict) -> tuple[bool | None, str]:
     """(passed, criterion) of one expectation result; passed is None when the figures do not
-    allow a verdict (no samples, event not reached)."""
+    allow a verdict (no samples, event not reached). :func:`judgement` adds the detail."""
+    result = judgement(scene, kind, body, figures)
+    return result.passed, result.criterion
+
+
+def unit_text(scene: Scene, dimension: tuple[int, int, int]) -> str:
+    """The scene's unit of a (length, mass, time) dimension, e.g. ``mm``, ``m/s``, ``N``,
+    ``kg m^2/s^2``; empty for a dimensionless value."""
+    if tuple(dimension) == (0, 0, 0):
+        return ""
+    if tuple(dimension) == (1, 1, -2):
+        return scene.units.force_unit()
+    names = (scene.units.length, scene.units.mass, scene.units.time)
+    up = [name if p == 1 else f"{name}^{p}" for name, p in zip(names, dimension, strict=True)
+          if p > 0]
+    down = [name if p == -1 else f"{name}^{-p}" for name, p in
+            zip(names, dimension, strict=True) if p < 0]
+    return " ".join(up or ["1"]) + ("/" + " ".join(down) if down else "")
+
+
+def judgement(scene: Scene, kind: str, body: str | None, figures: dict,
+              where: str = "", expectation=None) -> Judgement:
+    """Pass/fail, criterion and detail of one expectation result of ``kind`` about ``body``
+    with ``figures`` (:mod:`.expectation_figures`); ``where`` names the place of the judged
+    figure (a contact pair, a body) for the detail; ``expectation`` (the scene's
+    :class:`~clearbench.scenarios.expectations.Expectation`, if any) gives its parameters."""
     get = figures.get
+    length = scene.units.length
+    parameters = dict(expectation.parameters) if expectation is not None else {}
     if kind == "bounce_apex":
-        return _within(get("apex_max_relative_error"), 0.05), "apex within 5 %"
-    if kind in ("incline_stick", "sticks"):
-        bound = 1e-4 * body_size(scene.body(body))
-        return _within(get("displacement"), bound), f"displacement <= {bound:.3g}"
-    if kind == "incline_slide":
-        return _within(get("acceleration_relative_error"), 0.02), "acceleration within 2 %"
-    if kind == "sliding_stop":
-        return _within(analytic_error(kind, figures), 0.02), "stop distance within 2 %"
-    if kind == "rolling_transition":
-        return _within(get("final_speed_relative_error"), 0.02), "final speed within 2 %"
-    if kind == "pendulum":
-        period = _within(get("period_relative_error"), 0.01)
-        energy = _within(get("energy_drift"), 0.01)
-        verdicts = [v for v in (period, energy) if v is not None]
-        return (all(verdicts) if verdicts else None), "period within 1 %, energy drift <= 1 %"
-    if kind == "torque_free":
-        return _within(get("angular_momentum_drift"), 0.01), "momentum drift <= 1 %"
-    if kind == "slider_crank":
-        return _within(get("slider_position_relative_error"), 0.01), \
-            "slider position within 1 % of the crank"
-    if kind == "rocking_ratio":
-        return _within(get("ratio_relative_error"), 0.05), "impact ratio within 5 %"
-    if kind == "approaches_ideal":
-        return _within(get("clearance_excess_relative"), 1.0), "excess <= one clearance"
-    if kind == "energy_non_increasing":
-        return _within(get("energy_growth_relative"), 0.01), "energy growth <= 1 %"
-    if kind == "energy_conserved":
-        return _within(get("energy_drift_relative"), 0.01), "energy drift <= 1 %"
-    if kind == "no_penetration":
+        passed, detail = _percent("apex error", get("apex_max_relative_error"), 0.05)
+        criterion = "apex within 5 %"
+    elif kind in ("incline_stick", "sticks"):
+        bound = STICK_FRACTION * body_size(scene.body(body))
+        passed, detail = _bounded("displacement", get("displacement"), bound, length)
+        criterion = f"displacement <= {bound:.3g}"
+    elif kind == "incline_slide":
+        passed, detail = _percent("acceleration error", get("acceleration_relative_error"), 0.02)
+        criterion = "acceleration within 2 %"
+    elif kind == "sliding_stop":
+        bound = STICK_FRACTION * body_size(scene.body(body))
+        stop = get("stop_time")
+        parts = [_percent("stop distance error", analytic_error(kind, figures), 0.02)]
+        if stop is None or not math.isfinite(stop):
+            parts.append((False, "never stopped"))
+        else:
+            moved = _bounded(f"slid after the stop at {_number(stop)} {scene.units.time}",
+                             get("slide_after_stop"), bound, length)
+            parts.append(moved)
+        passed, detail = _all(parts)
+        criterion = f"stop distance within 2 %, then sticks (slides <= {bound:.3g})"
+    elif kind == "rolling_transition":
+        passed, detail = _percent("final speed error", get("final_speed_relative_error"), 0.02)
+        criterion = "final speed within 2 %"
+    elif kind == "rolling_incline":
+        speed = get("expected_final_speed")
+        bound = ROLLING_SLIP_FRACTION * speed if speed is not None else math.nan
+        passed, detail = _all([
+            _percent("distance error", get("distance_relative_error"), 0.02),
+            _bounded("slip speed", get("slip_speed_max"), bound,
+                     f"{length}/{scene.units.time}")])
+        criterion = (f"distance within 2 % of a t^2 / 2, slip <= "
+                     f"{_number(100 * ROLLING_SLIP_FRACTION)} % of the final speed")
+    elif kind == "pendulum":
+        passed, detail = _all([_percent("period error", get("period_relative_error"), 0.01),
+                               _percent("energy drift", get("energy_drift"), 0.01)])
+        criterion = "period within 1 %, energy drift <= 1 %"
+    elif kind == "torque_free":
+        passed, detail = _percent("momentum drift", get("angular_momentum_drift"), 0.01)
+        criterion = "momentum drift <= 1 %"
+    elif kind == "slider_crank":
+        passed, detail = _percent("slider error", get("slider_position_relative_error"), 0.01)
+        criterion = "slider position within 1 % of the crank"
+    elif kind == "rocking_ratio":
+        passed, detail = _percent("impact ratio error", get("ratio_relative_error"), 0.05)
+        criterion = "impact ratio within 5 %"
+    elif kind == "approaches_ideal":
+        passed, detail = _bounded("clearance excess", get("clearance_excess_relative"), 1.0,
+                                  "clearances")
+        criterion = "excess <= one clearance"
+    elif kind in ("energy_non_increasing", "energy_balance"):
+        passed, detail = _percent("energy growth", get("energy_growth_relative"),
+                                  ENERGY_GROWTH_ALLOWANCE)
+        criterion = f"energy growth <= {_number(100 * ENERGY_GROWTH_ALLOWANCE)} %"
+    elif kind == "energy_conserved":
+        passed, detail = _percent("energy drift", get("energy_drift_relative"),
+                                  ENERGY_GROWTH_ALLOWANCE)
+        criterion = f"energy drift <= {_number(100 * ENERGY_GROWTH_ALLOWANCE)} %"
+    elif kind == "no_penetration":
         bound = 0.01 * smallest_contact_feature(scene)
-        return _within(get("penetration_max"), bound), f"penetration <= {bound:.3g}"
-    return None, "no criterion"
+        passed, detail = _bounded("penetration", get("penetration_max"), bound, length)
+        criterion = f"penetration <= {bound:.3g}"
+    elif kind == "output_value":
+        output = next(o for o in scene.outputs if o.name == expectation.output)
+        unit = unit_text(scene, output.dimension)
+        passed, detail = _bounded(f"{output.name} off by", get("deviation"),
+                                  get("tolerance", math.nan), unit)
+        if get("value") is not None:
+            detail += (f": {_number(get('value'))} against {_number(get('expected'))}"
+                       f"{' ' + unit if unit else ''}")
+        tolerances = []
+        if "absolute_tolerance" in parameters:
+            tolerances.append(f"{_number(parameters['absolute_tolerance'])}"
+                              f"{' ' + unit if unit else ''}")
+        if "relative_tolerance" in parameters:
+            tolerances.append(f"{_number(100 * parameters['relative_tolerance'])} % of the "
+                              "expected value")
+        criterion = f"{output.name} within {' + '.join(tolerances)}"
+    else:
+        return Judgement(None, "no criterion", "no criterion")
+    if where and passed is not None:
+        detail += f" ({where})"
+    return Judgement(passed, criterion, detail)
 
 
 @dataclass(frozen=True)

@@ -299,7 +299,7 @@ def _messages_html(section: SceneSection) -> str:
         for result in json.loads(row["expectations"] or "[]"):
             if result.get("passed") is False:
                 items.append(f"<li><b>{_esc(label)}</b> fails {_esc(result.get('name'))}: "
-                             f"{_esc(result.get('message', ''))}</li>")
+                             f"{_esc(result.get('detail', ''))}</li>")
         if row.get("metrics_error"):
             items.append(f"<li><b>{_esc(label)}</b> metrics not computed: "
                          f"{_esc(row['metrics_error'])}</li>")

@@ -306,6 +306,28 @@ def rolling_sphere_final_speed(
     return require_finite("v0", v0) / (1.0 + require_positive("inertia_ratio", inertia_ratio))
 
 
+def rolling_incline_acceleration(angle: float, g: float, inertia_ratio: float) -> float:
+    """Acceleration down an incline of a body rolling without slipping,
+    ``g sin(angle) / (1 + k)`` (``5/7 g sin`` for the solid sphere).
+
+    Parameters
+    ----------
+    angle : float
+        Slope angle [rad].
+    g : float
+        Gravity [length / time^2], > 0.
+    inertia_ratio : float
+        k = I / (m r^2) [dimensionless], > 0, I about the rolling axis, r the rolling radius.
+
+    Returns
+    -------
+    float
+        [length / time^2]. Rolling needs tan(angle) <= mu (1 + k) / k; beyond, it slips.
+    """
+    return (require_positive("g", g) * math.sin(require_finite("angle", angle))
+            / (1.0 + require_positive("inertia_ratio", inertia_ratio)))
+
+
 def rolling_sphere_velocity(
     t, v0: float, mu: float, g: float, inertia_ratio: float = SOLID_SPHERE_INERTIA_RATIO
 ) -> np.ndarray:

@@ -8,10 +8,12 @@ from __future__ import annotations
 
 import math
 
+from clearbench.scenarios import analytic
 from clearbench.scenarios.bodies import Body, Motion
 from clearbench.scenarios.contacts import ContactPair
 from clearbench.scenarios.expectations import Expectation
 from clearbench.scenarios.inertia import solid_box, solid_sphere
+from clearbench.scenarios.outputs import PointPosition
 from clearbench.scenarios.registry import register
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.shapes import Box, Plane, Sphere
@@ -167,6 +169,50 @@ def rolling_sphere(initial_speed: float = 2.0, friction: float = 0.2,
             Expectation("rolling", kind="rolling_transition", body="ball", parameters={
                 "initial_speed": initial_speed, "friction": friction, "gravity": GRAVITY,
                 "radius": radius}),
+            Expectation("no_penetration", kind="no_penetration"),
+            Expectation("energy", kind="energy_non_increasing"),
+        ),
+        tags=("analytic", "friction"),
+    )
+
+
+@register("rolling-incline", tags=("analytic", "friction"),
+          summary="sphere released on a 20 degree incline, mu 0.5: rolls at 5/7 g sin")
+def rolling_incline(angle_degrees: float = 20.0, friction: float = 0.5,
+                    radius: float = 0.1) -> Scene:
+    mass = 1.0
+    angle = math.radians(angle_degrees)
+    tilt = _tilt_about_y(angle)
+    # Centre one radius above the origin along the tilted plane's normal; the slope descends
+    # toward +x along (cos, 0, -sin).
+    centre = (radius * math.sin(angle), 0.0, radius * math.cos(angle))
+    acceleration = analytic.rolling_incline_acceleration(angle, GRAVITY, 0.4)  # 2/5 m r^2
+    probe_time = 0.5  # s
+    travel = 0.5 * acceleration * probe_time**2
+    return Scene(
+        name="rolling-incline",
+        description=f"Solid sphere released at rest on a {angle_degrees} degree incline with "
+        f"mu {friction} (tan(angle) <= 7/2 mu): rolls without slipping at "
+        f"{acceleration:.4f} m/s^2.",
+        horizon=0.7,
+        time_step=1e-3,
+        bodies=(
+            ground(orientation=tilt),
+            Body("ball", mass=mass, inertia=solid_sphere(mass, radius), position=centre,
+                 orientation=tilt, shapes=(Sphere("sphere", radius=radius),)),
+        ),
+        contacts=(ContactPair("ball_floor", body_a="ground", shape_a="floor", body_b="ball",
+                              shape_b="sphere", friction=friction),),
+        outputs=(PointPosition("ball_x", body="ball", component="x"),),
+        expectations=(
+            Expectation("rolling", kind="rolling_incline", body="ball", parameters={
+                "angle": angle, "gravity": GRAVITY, "radius": radius}),
+            # The centre's x at 0.5 s, within 2 % of the distance travelled by then (the
+            # rolling criterion's 2 %).
+            Expectation("ball_x_at_half_second", kind="output_value", output="ball_x",
+                        parameters={"value": centre[0] + travel * math.cos(angle),
+                                    "absolute_tolerance": 0.02 * travel * math.cos(angle),
+                                    "time": probe_time}),
             Expectation("no_penetration", kind="no_penetration"),
             Expectation("energy", kind="energy_non_increasing"),
         ),
