@@ -8,6 +8,7 @@ import shutil
 
 from clearbench.harness.cli.common import (
     UserError,
+    add_engine_option,
     add_runner_options,
     assignments,
     engine_modules,
@@ -28,9 +29,9 @@ def register(subparsers) -> None:
         "from the store (--rerun to run it again).",
     )
     parser.add_argument("scene", help="registered scene name or scene file")
-    parser.add_argument("--engine", "-e", default="reference", metavar="ENGINE[PRESET]",
-                        help="engine and preset, e.g. reference, mujoco[elliptic] "
-                        "(default: reference)")
+    add_engine_option(parser, many=False, default="reference", flags=("--engine", "-e"),
+                      help="engine and preset, e.g. reference, mujoco[tuned] (default: "
+                      "reference)")
     parser.add_argument("--dt", type=float, default=None,
                         help="time step in the scene's time unit (default: the scene's)")
     parser.add_argument("--horizon", type=float, default=None,

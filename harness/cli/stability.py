@@ -6,6 +6,7 @@ import argparse
 
 from clearbench.harness.cli.common import (
     UserError,
+    add_engine_option,
     add_runner_options,
     engine_modules,
     make_runner,
@@ -31,8 +32,8 @@ def register(subparsers) -> None:
         "(pass / physics failed / diverged / crashed / timed out / unsupported) with the metrics "
         "of the case.",
     )
-    parser.add_argument("--engines", "-e", nargs="+", default=None, metavar="ENGINE[PRESET]",
-                        help="engines (default: every available engine, default preset)")
+    add_engine_option(parser, many=True,
+                      help="engines (default: every available engine, default preset)")
     parser.add_argument("--scenes", nargs="+", default=None, metavar="SCENE",
                         help=f"only these cases (default: every scene tagged {STIFF_TAG!r})")
     add_runner_options(parser, timeout=300.0)
