@@ -22,14 +22,14 @@ from dataclasses import dataclass
 
 
 class OptionError(ValueError):
-    """A bad run option: ``<engine> option NAME = VALUE: must be ...``."""
+    """A bad run option: ``<engine> option NAME=VALUE: must be ...``."""
 
     def __init__(self, engine: str, name: str, value, reason: str):
         self.engine = engine
         self.name = name
         self.value = value
         self.reason = reason
-        super().__init__(f"{engine} option {name} = {value!r}: {reason}")
+        super().__init__(f"{engine} option {name}={value!r}: {reason}")
 
 
 @dataclass(frozen=True)
@@ -172,7 +172,8 @@ class OptionTable:
             spec = self.specs.get(name)
             if spec is None:
                 raise OptionError(self.engine, name, value,
-                                  f"unknown option; options: {', '.join(self.names)}")
+                                  f"unknown {self.engine} option; options: "
+                                  f"{', '.join(self.names)}")
             reason = spec.problem(value)
             if reason:
                 raise OptionError(self.engine, name, value, reason)
