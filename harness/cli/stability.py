@@ -13,6 +13,7 @@ from clearbench.harness.cli.common import (
     open_store,
 )
 from clearbench.harness.measure.headline import METRIC_LABELS, format_value
+from clearbench.harness.measure.units import unit_text
 from clearbench.harness.measure.verdicts import run_verdict, verdict_text
 from clearbench.harness.studies.stability import (
     STIFF_TAG,
@@ -52,14 +53,17 @@ def run_stability(args: argparse.Namespace) -> int:
     outcome = runner.run_all(specs, rerun=args.rerun)
     print(f"{len(outcome.ran)} runs done, {len(outcome.skipped)} already in {store.directory}")
     rows = stability_rows(store.dataframe(), specs)
+    scenes = {spec.scene.name: spec.scene for spec in specs}
     case = None
     for row in rows:
         if row["case"] != case:
             case = row["case"]
             print(f"\n{case}: {row['summary']}")
         verdict = verdict_text(run_verdict(row["status"], row["expectations_passed"]))
-        figures = ", ".join(f"{METRIC_LABELS.get(n, (n,))[0]} {format_value(v)}"
-                            for n, v in row["metrics"].items())
+        scene = scenes.get(row["case"])
+        figures = ", ".join(
+            f"{METRIC_LABELS.get(n, (n,))[0]} {format_value(v, unit_text(n, scene, short=True))}"
+            for n, v in row["metrics"].items())
         print(f"  {row['engine']:<24} {verdict}")
         if row["reason"] and row["status"] != "ok":
             print(f"  {'':<24} {row['reason']}")
