@@ -7,8 +7,10 @@ An engine is a subpackage of :mod:`clearbench.adapters` (listed in
 and ``create(preset) -> Engine``. Its :class:`Engine` subclass declares:
 
 - ``name`` and its presets :attr:`Engine.PRESETS` (name -> option values) and run options
-  :attr:`Engine.OPTION_NAMES`; the base refuses an unknown preset when the engine is created and
-  unknown options before anything runs (:meth:`Engine.check_options`), for every engine alike;
+  :attr:`Engine.OPTIONS` (an :class:`~clearbench.adapters.options.OptionTable`: each option's
+  type, range and allowed values); the base refuses an unknown preset when the engine is
+  created, and an unknown option or a bad option value before anything runs
+  (:meth:`Engine.check_options`), for every engine alike;
 - what it does with each scene feature, one feature kind at a time: the base parses every
   feature of ``Scene.features`` once (:func:`clearbench.scenarios.features.parse_feature`) and
   asks :meth:`Engine.plain_capability`, :meth:`Engine.shape_capability`,
@@ -21,65 +23,22 @@ and ``create(preset) -> Engine``. Its :class:`Engine` subclass declares:
 
 :meth:`Engine.run` is the one entry point: options checked, unsupported scenes answered with
 an UNSUPPORTED trajectory and their reasons, then ``_run``. Failures of a run are statuses
-(crashed, diverged, ...) with messages; exceptions are for misuse (unknown preset or option).
+(crashed, diverged, ...) with messages; exceptions are for misuse (unknown preset, unknown option
+or bad option value).
 """
 
 from __future__ import annotations
 
 import enum
-import math
 from abc import ABC, abstractmethod
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
+from clearbench.adapters.options import OptionTable
 from clearbench.adapters.trajectory import RunStatus, Trajectory
 from clearbench.scenarios.features import FeatureKind, parse_feature
 from clearbench.scenarios.scene import Scene
-
-
-def option_error(engine: str, name: str, value, reason: str) -> ValueError:
-    """The error every engine raises for a bad option value: ``<engine> option NAME=VALUE:
-    reason``."""
-    return ValueError(f"{engine} option {name}={value!r}: {reason}")
-
-
-def check_option_number(engine: str, name: str, value, lower: float | None = None,
-                        upper: float | None = None, strict: bool = False) -> None:
-    """A finite real number (not a bool) within the bounds (``strict``: lower excluded);
-    :func:`option_error` otherwise."""
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise option_error(engine, name, value, "must be a finite number")
-    if lower is not None and (value <= lower if strict else value < lower):
-        raise option_error(engine, name, value,
-                           f"must be a finite number {'>' if strict else '>='} {lower:g}")
-    if upper is not None and value > upper:
-        raise option_error(engine, name, value, f"must be <= {upper:g}")
-
-
-def check_option_values(engine: str, settings, *, choices: Mapping[str, tuple] | None = None,
-                        booleans: Sequence[str] = (), integers: Mapping[str, int] | None = None,
-                        positive: Sequence[str] = (), non_negative: Sequence[str] = ()) -> None:
-    """The value checks every engine's settings dataclass runs in ``__post_init__``.
-
-    ``choices``: field -> allowed values; ``booleans``: fields that must be bool; ``integers``:
-    field -> least value (bools refused); ``positive`` / ``non_negative``: finite numbers > 0
-    / >= 0. Raises :func:`option_error` for the first field that fails, before any run.
-    """
-    for name, allowed in (choices or {}).items():
-        if getattr(settings, name) not in allowed:
-            raise option_error(engine, name, getattr(settings, name), f"must be one of {allowed}")
-    for name in booleans:
-        if not isinstance(getattr(settings, name), bool):
-            raise option_error(engine, name, getattr(settings, name), "must be true or false")
-    for name, least in (integers or {}).items():
-        value = getattr(settings, name)
-        if isinstance(value, bool) or not isinstance(value, int) or value < least:
-            raise option_error(engine, name, value, f"must be an integer >= {least}")
-    for name in positive:
-        check_option_number(engine, name, getattr(settings, name), lower=0.0, strict=True)
-    for name in non_negative:
-        check_option_number(engine, name, getattr(settings, name), lower=0.0)
 
 
 class Support(enum.Enum):
@@ -148,8 +107,8 @@ class Engine(ABC):
     name: ClassVar[str] = ""
     #: Named presets: preset -> option values it sets (each a separate engine variant).
     PRESETS: ClassVar[Mapping[str, Mapping]] = {"default": {}}
-    #: Names of the options a run may set (``RunSettings.options``).
-    OPTION_NAMES: ClassVar[Sequence[str]] = ()
+    #: The options a run may set (``RunSettings.options``): name, type, range, choices.
+    OPTIONS: ClassVar[OptionTable] = OptionTable("", ())
     #: Whether contacts are rigid (impulses, no contact spring: nonsmooth engines) rather than
     #: compliant; recorded in each trajectory's metadata as ``rigid_contacts``. A rigid engine
     #: stores no elastic energy in its contacts (``harness.measure.series.contact_energy``).
@@ -166,13 +125,18 @@ class Engine(ABC):
         """``engine[preset]`` as used in results."""
         return f"{self.name}[{self.preset}]"
 
-    @classmethod
-    def check_options(cls, options: Mapping | None) -> None:
-        """ValueError naming the options of ``options`` the engine does not have."""
-        unknown = sorted(set(options or {}) - set(cls.OPTION_NAMES))
-        if unknown:
-            raise ValueError(f"unknown {cls.name} options {unknown}; options: "
-                             f"{list(cls.OPTION_NAMES)}")
+    def check_options(self, options: Mapping | None) -> None:
+        """:class:`~clearbench.adapters.options.OptionError` (a ValueError) naming the first
+        option of ``options`` the engine does not have, or whose value its declaration
+        (:attr:`OPTIONS`) refuses, or that does not go with the preset and the other options
+        (:meth:`check_option_combination`)."""
+        self.OPTIONS.check(options)
+        self.check_option_combination(dict(options or {}))
+
+    def check_option_combination(self, options: Mapping) -> None:
+        """OptionError when options valid one by one do not go together with the preset or
+        with each other (default: they always do)."""
+        return None
 
     # ------------------------------------------------------------------ capabilities
     def capabilities(self, scene: Scene, options: Mapping | None = None
@@ -241,8 +205,9 @@ class Engine(ABC):
 
         Raises
         ------
-        ValueError
-            An option the engine does not have (before anything runs).
+        OptionError
+            An option the engine does not have, or a value it refuses (before anything
+            runs).
         """
         settings = settings or RunSettings()
         self.check_options(settings.options)
@@ -273,10 +238,13 @@ class ModuleEngine(Engine):
     RESOLVE_SETTINGS: ClassVar[Any] = None
 
     def settings(self, options: Mapping | None = None) -> Any:
-        """The preset overridden by ``options`` (names checked here, values by the settings
-        object: ValueError naming the option and value)."""
-        self.check_options(options)
+        """The preset overridden by ``options`` (checked against :attr:`OPTIONS` by the
+        settings object: OptionError naming the option and value)."""
+        self.OPTIONS.check(options)
         return type(self).RESOLVE_SETTINGS(self.preset, options)
+
+    def check_option_combination(self, options: Mapping) -> None:
+        self.settings(options)
 
     def capability_scene(self, scene: Scene, settings) -> Scene:
         """The scene the capabilities are stated for (default: as given; an engine that

@@ -28,13 +28,14 @@ import time
 import numpy as np
 
 from clearbench.adapters.base import Capability, Engine, RunSettings, Support
+from clearbench.adapters.options import OptionTable, number
 from clearbench.adapters.recording import record_schedule, step_count
 from clearbench.adapters.trajectory import RunStatus, Trajectory, scene_fields
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.features import PLAIN_FEATURES
 
 PRESETS = {"default": {}, "segfault": {}, "hang": {}, "nan": {}, "raise": {}, "energy": {}}
-OPTION_NAMES = ("sleep", "bias")
+OPTIONS = OptionTable("fake", (number("sleep", at_least=0.0), number("bias")))
 
 
 def availability() -> tuple[bool, str]:
@@ -64,7 +65,7 @@ class FakeEngine(Engine):
 
     name = "fake"
     PRESETS = PRESETS
-    OPTION_NAMES = OPTION_NAMES
+    OPTIONS = OPTIONS
 
     def plain_capability(self, context, name: str) -> Capability | None:
         if name == "clearance_joints":

@@ -167,7 +167,7 @@ def test_unknown_presets_and_options_are_refused_before_any_run(engine_name, mon
     monkeypatch.setattr(type(engine), "_run", _must_not_run)
     scene = get_scene("pendulum")
     bad = RunSettings(horizon=scene.time_step, options={"no_such_option": 1})
-    with pytest.raises(ValueError, match=f"unknown {engine_name} options.*no_such_option"):
+    with pytest.raises(ValueError, match=f"no_such_option.*unknown {engine_name} option"):
         engine.run(scene, bad)
     with pytest.raises(ValueError, match="no_such_option"):
         engine.capabilities(scene, bad.options)

@@ -38,7 +38,7 @@ def _short(scene: Scene, steps: int) -> RunSettings:
 def test_options_are_checked_before_any_run():
     engine = create("default")
     scene = get_scene("bouncing-ball-e0.5")
-    with pytest.raises(ValueError, match="unknown exudyn options"):
+    with pytest.raises(ValueError, match="unknown exudyn option"):
         engine.run(scene, RunSettings(options={"no_such_option": 1}))
     with pytest.raises(ValueError, match=r"friction_regularisation_velocity=-1"):
         engine.run(scene, RunSettings(options={"friction_regularisation_velocity": -1}))

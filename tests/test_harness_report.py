@@ -14,7 +14,7 @@ import pandas as pd
 import pytest
 
 from clearbench.harness.cli.main import main
-from clearbench.harness.measure.verdicts import VERDICTS
+from clearbench.harness.measure.verdicts import VERDICTS, run_verdict
 from clearbench.harness.report.figures import work_precision_figure
 from clearbench.harness.report.page import write_report
 from clearbench.harness.run.runner import Runner
@@ -117,6 +117,11 @@ MATRIX_CELL = re.compile(r"""<td class=["']verdict["'] data-scene=["']([^"']+)["
                          r"""data-engine=["']([^"']+)["'] data-verdict=["']([^"']+)["']""")
 
 
+#: A run's row of a per-scene table: engine, step, then the verdict cell (colour, text).
+RUN_ROW = re.compile(r"<tr><td>[^<]+</td><td class='num'>[^<]+</td><td style='background:"
+                     r"(#[0-9a-f]+)' title='[^']*'><span class='status'>([^<]+)</span></td>")
+
+
 def _matrix_cells(page: str) -> dict:
     return {(html.unescape(scene), html.unescape(engine)): html.unescape(verdict)
             for scene, engine, verdict in MATRIX_CELL.findall(page)}
@@ -136,6 +141,18 @@ def test_overview_matrix_shows_the_verdict_of_status_and_expectations(small_stor
     summary = paths["markdown"].read_text()
     for verdict in set(expected.values()) - {"not run"}:
         assert f"**{VERDICTS[verdict].symbol} {verdict}**" in summary
+    # Per scene, every run's verdict column holds its verdict (not its status), with the
+    # verdict's colour, in the page and in the summary.
+    runs = small_store.dataframe()
+    verdicts = sorted(run_verdict(r["status"], r["expectations_passed"])
+                      for _, r in runs.iterrows())
+    shown = RUN_ROW.findall(page)
+    assert sorted(verdict.split(" ", 1)[1] for _, verdict in shown) == verdicts
+    assert all(VERDICTS[verdict.split(" ", 1)[1]].colour == colour for colour, verdict in shown)
+    assert "physics failed" in verdicts
+    table_rows = [line.split(" | ")[2] for line in summary.splitlines()
+                  if re.match(r"^\| fake\[\w+\] \| [\d.e-]+ \|", line)]
+    assert sorted(v.split(" ", 1)[1] for v in table_rows) == verdicts
 
 
 def _chromium() -> str | None:

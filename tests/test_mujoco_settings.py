@@ -118,7 +118,7 @@ def test_presets_and_options():
     assert tuned.contact_timeconst(1e-4) == pytest.approx(2e-4)
     # An explicit solref replaces the step-relative timeconst of the preset.
     assert resolve_settings("tuned", {"solref": (0.005, 0.07)}).contact_timeconst(1e-3) == 0.005
-    with pytest.raises(ValueError, match="unknown mujoco options"):
+    with pytest.raises(ValueError, match="unknown mujoco option"):
         create("tuned").settings({"solref_typo": 1})
     with pytest.raises(ValueError, match="unknown mujoco preset"):
         create("fast")

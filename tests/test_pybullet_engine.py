@@ -191,7 +191,7 @@ def test_pybullet_sees_the_c60_gaps_at_t0():
     ({"linear_damping": -0.1}, "linear_damping=-0.1"),
     ({"collision_margin": math.nan}, "collision_margin=nan"),
     ({"use_split_impulse": 1}, "use_split_impulse=1"),
-    ({"no_such_option": 1}, "unknown pybullet options"),
+    ({"no_such_option": 1}, "unknown pybullet option"),
 ])
 def test_bad_options_are_refused_before_any_run(options, message):
     with pytest.raises(ValueError, match=message.replace("(", r"\(").replace("[", r"\[")):

@@ -96,7 +96,7 @@ def test_capabilities_name_unsupported_pairs_with_reasons():
 def test_unknown_options_and_presets_are_rejected():
     with pytest.raises(ValueError, match="preset"):
         siconos_engine.create("fast")
-    with pytest.raises(ValueError, match="unknown siconos options"):
+    with pytest.raises(ValueError, match="unknown siconos option"):
         siconos_engine.create().resolved_options(get_scene("pendulum"),
                                                  RunSettings(options={"thta": 1.0}))
     with pytest.raises(ValueError, match="solver"):

@@ -29,7 +29,7 @@ from clearbench.adapters.exudyn.build import build_system, load_exudyn
 from clearbench.adapters.exudyn.capabilities import FeatureContext, clearance_summary
 from clearbench.adapters.exudyn.run import Runner
 from clearbench.adapters.exudyn.settings import (
-    OPTION_NAMES,
+    OPTIONS,
     PRESETS,
     ExudynSettings,
     resolve_settings,
@@ -40,7 +40,7 @@ from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.units import SI
 from clearbench.scenarios.validation import TIME
 
-__all__ = ["OPTION_NAMES", "PRESETS", "ExudynEngine", "availability", "create"]
+__all__ = ["OPTIONS", "PRESETS", "ExudynEngine", "availability", "create"]
 
 
 def availability() -> tuple[bool, str]:
@@ -62,7 +62,7 @@ class ExudynEngine(Engine):
 
     name = "exudyn"
     PRESETS = PRESETS
-    OPTION_NAMES = OPTION_NAMES
+    OPTIONS = OPTIONS
 
     def settings(self, options: dict | None = None) -> ExudynSettings:
         """The preset overridden by ``options`` (names and values checked: ValueError)."""

@@ -30,7 +30,7 @@ import dataclasses
 import math
 from dataclasses import dataclass
 
-from clearbench.adapters.base import check_option_number, check_option_values, option_error
+from clearbench.adapters.options import OptionTable, boolean, choice, integer, number
 
 #: Named presets; each is a separate engine variant ``exudyn[<preset>]`` in results.
 PRESETS: dict[str, dict] = {
@@ -208,45 +208,54 @@ class ExudynSettings:
     guard_interval: int = 10
 
     def __post_init__(self) -> None:
-        check_option_values(
-            "exudyn", self,
-            choices={"solver": SOLVERS, "linear_solver": LINEAR_SOLVERS,
-                     "ring_journal": RING_JOURNAL_MODELS, "law_loads": LAW_LOAD_MODES,
-                     "internal_units": UNIT_CHOICES, "impact_model": (0, 1, 2),
-                     "stiffness_time_step": ("run", "scene"), "step_loop": STEP_LOOPS},
-            booleans=("adaptive_step", "modified_newton", "ignore_singular_jacobian",
-                      "closed_loop_full_pivot", "recommended_step"),
-            integers={"newton_max_iterations": 1, "discontinuous_max_iterations": 1,
-                      "ring_spheres": 3, "journal_facets": 3, "journal_spheres": 1,
-                      "disc_segments": 3, "guard_interval": 1},
-            positive=("minimum_step_fraction", "newton_relative_tolerance",
-                      "newton_absolute_tolerance", "discontinuous_tolerance",
-                      "contact_period_steps", "contact_stiffness_exponent",
-                      "friction_regularisation_velocity", "plastic_restitution",
-                      "ring_sphere_radius", "facet_window", "corner_sphere_radius", "plane_size",
-                      "energy_gain_tolerance"),
-            non_negative=("contact_damping_ratio", "minimum_impact_velocity"))
-        check_option_number("exudyn", "spectral_radius", self.spectral_radius, 0.0, 1.0)
-        if not self.plastic_restitution <= 1.0:
-            _fail("plastic_restitution", self.plastic_restitution, "must be in (0, 1]")
-        if not self.minimum_step_fraction < 1.0:
-            _fail("minimum_step_fraction", self.minimum_step_fraction, "must be < 1")
-        if self.facet_window > math.pi:
-            _fail("facet_window", self.facet_window, "must be <= pi")
-        if self.contact_stiffness is not None:
-            check_option_number("exudyn", "contact_stiffness", self.contact_stiffness, 0.0,
-                                strict=True)
+        OPTIONS.check_settings(self)
 
     def as_dict(self) -> dict:
         """Plain-dict form for trajectory metadata."""
         return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
 
 
-def _fail(name: str, value, reason: str) -> None:
-    raise option_error("exudyn", name, value, reason)
-
-
-OPTION_NAMES = tuple(f.name for f in dataclasses.fields(ExudynSettings))
+#: Type, range and allowed values of every field of :class:`ExudynSettings`.
+OPTIONS = OptionTable("exudyn", (
+    choice("solver", SOLVERS),
+    number("spectral_radius", at_least=0.0, at_most=1.0),
+    boolean("adaptive_step"),
+    number("minimum_step_fraction", above=0.0, below=1.0),
+    boolean("modified_newton"),
+    number("newton_relative_tolerance", above=0.0),
+    number("newton_absolute_tolerance", above=0.0),
+    integer("newton_max_iterations", at_least=1),
+    integer("discontinuous_max_iterations", at_least=1),
+    number("discontinuous_tolerance", above=0.0),
+    boolean("recommended_step"),
+    choice("step_loop", STEP_LOOPS),
+    choice("linear_solver", LINEAR_SOLVERS),
+    boolean("ignore_singular_jacobian"),
+    boolean("closed_loop_full_pivot"),
+    choice("impact_model", (0, 1, 2)),
+    number("contact_stiffness", above=0.0, optional=True),
+    number("contact_period_steps", above=0.0),
+    choice("stiffness_time_step", ("run", "scene")),
+    number("contact_stiffness_exponent", above=0.0),
+    number("contact_damping_ratio", at_least=0.0),
+    number("minimum_impact_velocity", at_least=0.0),
+    number("friction_regularisation_velocity", above=0.0),
+    number("plastic_restitution", above=0.0, at_most=1.0),
+    integer("ring_spheres", at_least=3),
+    number("ring_sphere_radius", above=0.0),
+    integer("journal_facets", at_least=3),
+    number("facet_window", above=0.0, at_most=math.pi),
+    integer("journal_spheres", at_least=1),
+    choice("ring_journal", RING_JOURNAL_MODELS),
+    number("corner_sphere_radius", above=0.0),
+    number("plane_size", above=0.0),
+    integer("disc_segments", at_least=3),
+    choice("law_loads", LAW_LOAD_MODES),
+    choice("internal_units", UNIT_CHOICES),
+    number("energy_gain_tolerance", above=0.0),
+    integer("guard_interval", at_least=1),
+))
+OPTION_NAMES = OPTIONS.names
 
 
 def resolve_settings(preset: str, options: dict | None = None) -> ExudynSettings:

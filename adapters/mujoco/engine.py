@@ -40,7 +40,7 @@ from clearbench.adapters.mujoco.capabilities import (
 )
 from clearbench.adapters.mujoco.run import Runner
 from clearbench.adapters.mujoco.settings import (
-    OPTION_NAMES,
+    OPTIONS,
     PRESETS,
     MujocoSettings,
     resolve_settings,
@@ -53,7 +53,7 @@ from clearbench.scenarios.validation import TIME, VELOCITY
 
 logger = logging.getLogger(__name__)
 
-__all__ = ["OPTION_NAMES", "PRESETS", "MujocoEngine", "availability", "create"]
+__all__ = ["OPTIONS", "PRESETS", "MujocoEngine", "availability", "create"]
 
 
 def availability() -> tuple[bool, str]:
@@ -73,7 +73,7 @@ class MujocoEngine(ModuleEngine):
 
     name = "mujoco"
     PRESETS = PRESETS
-    OPTION_NAMES = OPTION_NAMES
+    OPTIONS = OPTIONS
     CAPABILITIES = capabilities
     RESOLVE_SETTINGS = staticmethod(resolve_settings)
 

@@ -20,7 +20,7 @@ import dataclasses
 import math
 from dataclasses import dataclass
 
-from clearbench.adapters.base import check_option_values
+from clearbench.adapters.options import OptionTable, boolean, choice, integer, number, numbers
 
 #: MuJoCo's own defaults (mjOption and the default geom solref/solimp of MuJoCo 3/4).
 MUJOCO_DEFAULT_SOLREF = (0.02, 1.0)
@@ -155,28 +155,9 @@ class MujocoSettings:
     ccd_tolerance_relative: float | None = None
 
     def __post_init__(self) -> None:
-        check_option_values(
-            "mujoco", self,
-            choices={"integrator": ("Euler", "implicit", "implicitfast", "RK4"),
-                     "cone": ("pyramidal", "elliptic"), "solver": ("Newton", "CG", "PGS"),
-                     "ring_piece": ("sphere", "capsule", "box"),
-                     "internal_units": ("SI", "scene")},
-            integers={"ring_pieces": 3, "bore_pieces": 3, "iterations": 1,
-                      "guard_interval": 1, "noslip_iterations": 0},
-            positive=("impratio", "tolerance", "restitution_contact_steps",
-                      "plastic_damping_ratio", "ring_piece_radius", "bore_wall",
-                      "face_thickness", "plane_box_size", "driver_armature_ratio",
-                      "energy_gain_tolerance"))
-        for name in ("solref", "equality_solref"):
-            value = tuple(float(x) for x in getattr(self, name))
-            if len(value) != 2:
-                raise ValueError(f"mujoco option {name}={value!r}: needs 2 numbers")
-            object.__setattr__(self, name, value)
-        for name in ("solimp", "equality_solimp"):
-            value = tuple(float(x) for x in getattr(self, name))
-            if len(value) != 5:
-                raise ValueError(f"mujoco option {name}={value!r}: needs 5 numbers")
-            object.__setattr__(self, name, value)
+        OPTIONS.check_settings(self)
+        for name in ("solref", "equality_solref", "solimp", "equality_solimp"):
+            object.__setattr__(self, name, tuple(float(x) for x in getattr(self, name)))
 
     def as_dict(self) -> dict:
         """Plain-dict form for trajectory metadata."""
@@ -194,7 +175,43 @@ class MujocoSettings:
         return self.equality_solref[0]
 
 
-OPTION_NAMES = tuple(f.name for f in dataclasses.fields(MujocoSettings))
+#: Type, range and allowed values of every field of :class:`MujocoSettings` (solref: a positive
+#: (timeconst, dampratio) or MuJoCo's direct (-stiffness, -damping), so any sign; solimp: five
+#: numbers MuJoCo clamps into its own ranges).
+OPTIONS = OptionTable("mujoco", (
+    choice("integrator", ("Euler", "implicit", "implicitfast", "RK4")),
+    choice("cone", ("pyramidal", "elliptic")),
+    number("impratio", above=0.0),
+    choice("solver", ("Newton", "CG", "PGS")),
+    integer("iterations", at_least=1),
+    number("tolerance", above=0.0),
+    integer("noslip_iterations", at_least=0),
+    number("noslip_tolerance", above=0.0),
+    numbers("solref", 2),
+    numbers("solimp", 5),
+    number("timeconst_steps", above=0.0, optional=True),
+    numbers("equality_solref", 2),
+    numbers("equality_solimp", 5),
+    number("equality_timeconst_steps", above=0.0, optional=True),
+    number("restitution_contact_steps", above=0.0),
+    number("plastic_damping_ratio", above=0.0),
+    boolean("map_plastic"),
+    integer("ring_pieces", at_least=3),
+    choice("ring_piece", ("sphere", "capsule", "box")),
+    number("ring_piece_radius", above=0.0),
+    integer("bore_pieces", at_least=3),
+    number("bore_wall", above=0.0),
+    number("face_thickness", above=0.0),
+    number("plane_box_size", above=0.0),
+    number("closure_spacing", above=0.0, optional=True),
+    number("driver_armature_ratio", above=0.0),
+    choice("internal_units", ("SI", "scene")),
+    number("energy_gain_tolerance", above=0.0),
+    integer("guard_interval", at_least=1),
+    boolean("refsafe"),
+    number("ccd_tolerance_relative", above=0.0, optional=True),
+))
+OPTION_NAMES = OPTIONS.names
 
 
 def resolve_settings(preset: str, options: dict | None = None) -> MujocoSettings:

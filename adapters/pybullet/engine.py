@@ -25,7 +25,7 @@ from clearbench.adapters.pybullet import capabilities
 from clearbench.adapters.pybullet.capabilities import ring_summary
 from clearbench.adapters.pybullet.geometry import margin_feature_length
 from clearbench.adapters.pybullet.settings import (
-    OPTION_NAMES,
+    OPTIONS,
     PRESETS,
     PybulletSettings,
     resolve_settings,
@@ -36,7 +36,7 @@ from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.units import MM_G_MS, SI, UnitSystem
 from clearbench.scenarios.validation import LENGTH, TIME, VELOCITY
 
-__all__ = ["AUTO_MILLIMETRE_BELOW", "OPTION_NAMES", "PRESETS", "PybulletEngine",
+__all__ = ["AUTO_MILLIMETRE_BELOW", "OPTIONS", "PRESETS", "PybulletEngine",
            "availability", "create", "internal_units"]
 
 #: Below this smallest feature [m], ``internal_units = 'auto'`` models in mm-g-ms instead of SI.
@@ -65,7 +65,7 @@ class PybulletEngine(ModuleEngine):
 
     name = "pybullet"
     PRESETS = PRESETS
-    OPTION_NAMES = OPTION_NAMES
+    OPTIONS = OPTIONS
     CAPABILITIES = capabilities
     RESOLVE_SETTINGS = staticmethod(resolve_settings)
 

@@ -42,7 +42,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
-from clearbench.adapters.base import check_option_number, check_option_values
+from clearbench.adapters.options import OptionTable, boolean, choice, integer, number
 
 #: Compound shapes of PyBullet keep at most this many children (MAX_COMPOUND_COLLISION_SHAPES of
 #: SharedMemoryCommands.h); more are dropped silently (docs/engines/pybullet.md).
@@ -205,51 +205,52 @@ class PybulletSettings:
     guard_interval: int = 10
 
     def __post_init__(self) -> None:
-        check_option_values(
-            "pybullet", self,
-            choices={"body_model": ("multibody", "rigid"),
-                     "internal_units": ("SI", "scene", "mm-g-ms", "auto")},
-            booleans=("use_split_impulse", "enable_cone_friction",
-                      "deterministic_overlapping_pairs", "friction_anchor",
-                      "switch_off_joint_motors"),
-            integers={"num_solver_iterations": 1, "ring_pieces": 3, "bore_pieces": 3,
-                      "guard_interval": 1},
-            positive=("erp", "contact_breaking_threshold", "ring_piece_radius",
-                      "bore_piece_radius", "face_thickness", "plane_box_size",
-                      "driver_max_force", "energy_gain_tolerance"),
-            non_negative=("solver_residual_threshold", "warm_starting_factor", "contact_erp",
-                          "friction_erp", "global_cfm", "contact_slop",
-                          "restitution_velocity_threshold"))
-        for name in ("erp", "contact_erp", "friction_erp", "warm_starting_factor"):
-            _check_number(name, getattr(self, name), upper=1.0)
-        _check_number("split_impulse_penetration_threshold",
-                      self.split_impulse_penetration_threshold)
-        optional = {"linear_damping": (0.0, False), "angular_damping": (0.0, False),
-                    "max_joint_velocity": (0.0, True),
-                    "contact_processing_threshold": (0.0, False),
-                    "collision_margin": (0.0, True), "collision_margin_relative": (0.0, True),
-                    "closure_spacing": (0.0, True)}
-        for name, (lower, strict) in optional.items():
-            value = getattr(self, name)
-            if value is not None:
-                _check_number(name, value, lower=lower, strict=strict)
-        for name in ("linear_damping", "angular_damping"):
-            value = getattr(self, name)
-            if value is not None:
-                _check_number(name, value, upper=1.0)
+        OPTIONS.check_settings(self)
 
     def as_dict(self) -> dict:
         """Plain-dict form for trajectory metadata."""
         return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
 
 
-def _check_number(name: str, value, lower: float | None = None, upper: float | None = None,
-                  strict: bool = False) -> None:
-    """A finite real number within the bounds (ValueError naming the option and value)."""
-    check_option_number("pybullet", name, value, lower, upper, strict)
-
-
-OPTION_NAMES = tuple(f.name for f in dataclasses.fields(PybulletSettings))
+#: Type, range and allowed values of every field of :class:`PybulletSettings` (ERP factors and
+#: damping are fractions per step: [0, 1]).
+OPTIONS = OptionTable("pybullet", (
+    integer("num_solver_iterations", at_least=1),
+    number("solver_residual_threshold", at_least=0.0),
+    number("warm_starting_factor", at_least=0.0, at_most=1.0),
+    number("contact_erp", at_least=0.0, at_most=1.0),
+    number("erp", above=0.0, at_most=1.0),
+    number("friction_erp", at_least=0.0, at_most=1.0),
+    number("global_cfm", at_least=0.0),
+    boolean("use_split_impulse"),
+    number("split_impulse_penetration_threshold"),
+    number("contact_breaking_threshold", above=0.0),
+    number("contact_slop", at_least=0.0),
+    number("restitution_velocity_threshold", at_least=0.0),
+    boolean("enable_cone_friction"),
+    boolean("deterministic_overlapping_pairs"),
+    choice("body_model", ("multibody", "rigid")),
+    number("linear_damping", at_least=0.0, at_most=1.0, optional=True),
+    number("angular_damping", at_least=0.0, at_most=1.0, optional=True),
+    number("max_joint_velocity", above=0.0, optional=True),
+    boolean("friction_anchor"),
+    number("contact_processing_threshold", at_least=0.0, optional=True),
+    number("collision_margin", above=0.0, optional=True),
+    number("collision_margin_relative", above=0.0, optional=True),
+    boolean("switch_off_joint_motors"),
+    integer("ring_pieces", at_least=3),
+    number("ring_piece_radius", above=0.0),
+    integer("bore_pieces", at_least=3),
+    number("bore_piece_radius", above=0.0),
+    number("face_thickness", above=0.0),
+    number("plane_box_size", above=0.0),
+    number("closure_spacing", above=0.0, optional=True),
+    number("driver_max_force", above=0.0),
+    choice("internal_units", ("SI", "scene", "mm-g-ms", "auto")),
+    number("energy_gain_tolerance", above=0.0),
+    integer("guard_interval", at_least=1),
+))
+OPTION_NAMES = OPTIONS.names
 
 
 def resolve_settings(preset: str, options: dict | None = None) -> PybulletSettings:

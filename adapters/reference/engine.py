@@ -10,23 +10,25 @@ round-off floor.
 from __future__ import annotations
 
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
 
 import clearbench
 from clearbench.adapters.base import Capability, Engine, RunSettings
+from clearbench.adapters.options import OptionError
 from clearbench.adapters.recording import SampleRecorder, step_count
 from clearbench.adapters.reference import capabilities
 from clearbench.adapters.reference.build import build
-from clearbench.adapters.reference.settings import OPTION_NAMES, PRESETS, stepper_settings
+from clearbench.adapters.reference.settings import OPTIONS, PRESETS, stepper_settings
 from clearbench.adapters.trajectory import RunStatus, Trajectory
 from clearbench.kernels.quaternion import quat_rotate_batch
 from clearbench.ref_solver.stepper import StepperSettings
 from clearbench.ref_solver.system import State
 from clearbench.scenarios.scene import Scene
 
-__all__ = ["OPTION_NAMES", "PRESETS", "ReferenceEngine", "availability", "create"]
+__all__ = ["OPTIONS", "PRESETS", "ReferenceEngine", "availability", "create"]
 
 
 def availability() -> tuple[bool, str]:
@@ -43,7 +45,7 @@ class ReferenceEngine(Engine):
     name = "reference"
     RIGID_CONTACTS = True
     PRESETS = PRESETS
-    OPTION_NAMES = OPTION_NAMES
+    OPTIONS = OPTIONS
 
     def plain_capability(self, context, name: str) -> Capability | None:
         return capabilities.plain_capability(name)
@@ -56,6 +58,15 @@ class ReferenceEngine(Engine):
 
     def pair_capability(self, context, kind_a: str, kind_b: str) -> Capability | None:
         return capabilities.pair_capability(kind_a, kind_b)
+
+    def check_option_combination(self, options: Mapping) -> None:
+        # An explicit localise_impacts = true needs the projection (without it, the preset's
+        # localisation is switched off by stepper_settings).
+        projection = {**PRESETS[self.preset], **options}["projection"]
+        if options.get("localise_impacts") and not projection:
+            raise OptionError(self.name, "localise_impacts", True,
+                              "needs projection = true (it relies on the activation loop of "
+                              "the combined projection)")
 
     def stepper_settings(self, scene: Scene, settings: RunSettings) -> StepperSettings:
         """Preset + options (checked), with tolerances relative to the scene's smallest

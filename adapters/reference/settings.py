@@ -25,7 +25,8 @@ from __future__ import annotations
 import numpy as np
 
 from clearbench.adapters.base import RunSettings
-from clearbench.ref_solver.contact_problem import SolverOptions
+from clearbench.adapters.options import OptionTable, boolean, choice, integer, number
+from clearbench.ref_solver.contact_problem import METHODS, SolverOptions
 from clearbench.ref_solver.stepper import StepperSettings
 from clearbench.scenarios.scales import feature_lengths
 from clearbench.scenarios.scene import Scene
@@ -38,21 +39,27 @@ PRESETS: dict[str, dict] = {
     "newton": {"theta": 0.5, "projection": True, "method": "newton", "localise_impacts": True},
     "implicit": {"theta": 1.0, "projection": True, "method": "hybrid", "localise_impacts": True},
 }
-OPTION_NAMES = ("theta", "projection", "method", "tolerance", "max_iterations",
-                "position_tolerance", "restitution_threshold", "joint_law", "localise_impacts",
-                "roundoff_floor")
+#: Type, range and allowed values of every option (theta: the theta-method is stable for
+#: [1/2, 1]; tolerance: relative residual; position_tolerance [L]; restitution_threshold [L/T]).
+OPTIONS = OptionTable("reference", (
+    number("theta", at_least=0.5, at_most=1.0),
+    boolean("projection"),
+    choice("method", ("hybrid", *METHODS)),
+    number("tolerance", above=0.0),
+    integer("max_iterations", at_least=1),
+    number("position_tolerance", above=0.0),
+    number("restitution_threshold", at_least=0.0),
+    choice("joint_law", ("midpoint", "end")),
+    boolean("localise_impacts"),
+    boolean("roundoff_floor"),
+))
+OPTION_NAMES = OPTIONS.names
 
 
 def stepper_settings(preset: str, scene: Scene, settings: RunSettings) -> StepperSettings:
-    """The preset overridden by ``settings.options`` (names checked by the engine), with
-    tolerances relative to the scene's smallest feature; ValueError for a flag that is not
-    true or false."""
+    """The preset overridden by ``settings.options`` (names and values checked by the engine
+    against :data:`OPTIONS`), with tolerances relative to the scene's smallest feature."""
     options = dict(PRESETS[preset])
-    for flag in ("localise_impacts", "roundoff_floor"):
-        value = settings.options.get(flag)
-        if value is not None and not isinstance(value, bool):
-            raise ValueError(f"reference option {flag} must be true or false, got "
-                             f"{value!r}")
     localise = settings.options.get("localise_impacts")
     options.update(settings.options)
     if localise is None:

@@ -50,6 +50,7 @@ from pathlib import Path
 import numpy as np
 
 from clearbench.adapters.base import Capability, Engine, RunSettings, Support
+from clearbench.adapters.options import OptionTable, boolean, choice, integer, number
 from clearbench.adapters.siconos.process import (
     SICONOS_PYTHON,
     WorkerStatus,
@@ -84,13 +85,31 @@ DEFAULTS: dict = {
     "timeout": 3600.0,
     "fault": "",
 }
-OPTION_NAMES = ("theta", "projection", "solver") + tuple(DEFAULTS) + (
-    "constraint_tolerance", "activation_threshold")
 SOLVERS = ("nsgs", "nsn-ac")
 CONTACT_FRAMES = ("shared", "siconos-builtin")
 PROJECTION_SOLVERS = ("enum", "pgs")
 FAULTS = ("", "segfault", "hang", "exception")
 GMP_REDUCTIONS = ("auto", "gs", "substitute", "assemble", "mlcp")
+#: Type, range and allowed values of every option (lengths [L] in the scene's unit; theta: the
+#: theta-method in (0, 1]; tolerance: Siconos's normalised residual; timeout [s]).
+OPTIONS = OptionTable("siconos", (
+    number("theta", above=0.0, at_most=1.0),
+    boolean("projection"),
+    choice("solver", SOLVERS),
+    number("tolerance", above=0.0),
+    integer("max_iterations", at_least=1),
+    integer("newton_iterations", at_least=1),
+    number("newton_tolerance", above=0.0),
+    integer("projection_max_iterations", at_least=1),
+    choice("projection_solver", PROJECTION_SOLVERS),
+    choice("contact_frame", CONTACT_FRAMES),
+    choice("gmp_reduction", GMP_REDUCTIONS),
+    number("timeout", above=0.0),
+    choice("fault", FAULTS),
+    number("constraint_tolerance", above=0.0),
+    number("activation_threshold", at_least=0.0),
+))
+OPTION_NAMES = OPTIONS.names
 
 _JOINT_CLASSES = {"revolute": "PivotJointR", "spherical": "KneeJointR",
                   "prismatic": "PrismaticJointR", "fixed": "FixedJointR"}
@@ -170,7 +189,7 @@ class SiconosEngine(Engine):
     name = "siconos"
     RIGID_CONTACTS = True
     PRESETS = PRESETS
-    OPTION_NAMES = OPTION_NAMES
+    OPTIONS = OPTIONS
 
     # ------------------------------------------------------------------ capabilities
     def plain_capability(self, context, name: str) -> Capability | None:
@@ -235,7 +254,7 @@ class SiconosEngine(Engine):
 
     # ------------------------------------------------------------------ settings
     def resolved_options(self, scene: Scene, settings: RunSettings) -> dict:
-        """Preset + defaults + ``settings.options``, checked."""
+        """Preset + defaults + ``settings.options`` (checked against :data:`OPTIONS`)."""
         self.check_options(settings.options)
         options = dict(DEFAULTS)
         options.update(PRESETS[self.preset])
@@ -258,13 +277,6 @@ class SiconosEngine(Engine):
             # but an assembled system with redundant joint rows (a planar closed loop rebuilt
             # in 3D) is singular: the slider-crank aborted on NaN. Gauss-Seidel there.
             options["gmp_reduction"] = "gs" if "closed_loop" in scene.features else "assemble"
-        for name, allowed in (("solver", SOLVERS), ("contact_frame", CONTACT_FRAMES),
-                              ("projection_solver", PROJECTION_SOLVERS), ("fault", FAULTS),
-                              ("gmp_reduction", GMP_REDUCTIONS)):
-            if options[name] not in allowed:
-                raise ValueError(f"siconos option {name}={options[name]!r}; allowed: {allowed}")
-        if not 0.0 < float(options["theta"]) <= 1.0:
-            raise ValueError(f"siconos option theta={options['theta']!r} must be in (0, 1]")
         return options
 
     # ------------------------------------------------------------------ run

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from clearbench.adapters import siconos
 from clearbench.harness.cli import bench_against
-from clearbench.harness.cli.common import UserError, assignments
+from clearbench.harness.cli.common import UserError, add_engine_option, assignments
 from clearbench.harness.run.engine_choice import RunInputError, resolve_engine
 from clearbench.harness.studies.benchmarks import (
     clearance_ladder,
@@ -213,10 +213,9 @@ def _engine_option(parser: argparse.ArgumentParser) -> None:
 
 
 def _physics_table_options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--engine", "-e", action="append", dest="engines",
-                        metavar="ENGINE[PRESET]",
-                        help="engine and preset, e.g. 'pybullet[tuned]' (repeatable; a column "
-                        "per engine and time step)")
+    add_engine_option(parser, many=True, flags=("--engine", "-e"),
+                      help="engine and preset, e.g. 'pybullet[tuned]' (a column per engine and "
+                      "time step)")
     _table_options(parser)
 
 
@@ -231,7 +230,8 @@ def _mujoco_table_options(parser: argparse.ArgumentParser) -> None:
 
 def _engines(labels: list[str], options: dict) -> dict:
     """``ENGINE[PRESET]`` labels -> created engines, each checked (known, available, preset,
-    the names of ``options``) before any run; UserError (exit 2) naming the bad value."""
+    the names and values of ``options``) before any run; UserError (exit 2) naming the bad
+    value."""
     if not labels:
         raise UserError("nothing to run: give --engine ENGINE[PRESET] (or --reference)")
     engines = {}
@@ -241,12 +241,6 @@ def _engines(labels: list[str], options: dict) -> dict:
         except RunInputError as error:
             raise UserError(str(error)) from None
         engine = importlib.import_module(choice.module).create(choice.preset)
-        resolve_settings = getattr(engine, "settings", None)  # engines with a settings object
-        if options and callable(resolve_settings):
-            try:
-                resolve_settings(options)  # the option values, checked by the engine
-            except ValueError as error:
-                raise UserError(f"--option: {error}") from None
         engines[label if label == "reference" else choice.label] = engine
     return engines
 
@@ -288,8 +282,7 @@ def bench_mujoco_table(args: argparse.Namespace) -> int:
 
 
 def _contact_cost_options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--engine", "-e", action="append", dest="engines",
-                        metavar="ENGINE[PRESET]", help="engine and preset (repeatable)")
+    add_engine_option(parser, many=True, flags=("--engine", "-e"), help="engine and preset")
     parser.add_argument("--boxes", action="append", type=int,
                         help="box count (repeatable; default: 1 4 9 16 26)")
     parser.add_argument("--dt", action="append", type=float, dest="time_steps",

@@ -29,6 +29,7 @@ from clearbench.harness.c60.validation import validate, write_figures, write_jso
 from clearbench.harness.c60.work_precision import steps_for_target, work_precision
 from clearbench.harness.cli.common import (
     UserError,
+    add_engine_option,
     add_runner_options,
     engine_modules,
     make_runner,
@@ -82,9 +83,9 @@ def register(subparsers) -> None:
     )
     compare.add_argument("--plan", choices=sorted(PLANS), default="demo",
                          help="which runs (default demo)")
-    compare.add_argument("--engines", "-e", nargs="+", default=None, metavar="ENGINE[PRESET]",
-                         help="only these labels of the plan (default: every label whose "
-                         "engine is available)")
+    add_engine_option(compare, many=True,
+                      help="only these labels of the plan (default: every label whose engine "
+                      "is available)")
     compare.add_argument("--out", default="reports/out", metavar="DIR",
                          help="report directory (default reports/out)")
     add_runner_options(compare, timeout=7200.0)

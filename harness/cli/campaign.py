@@ -13,7 +13,12 @@ import os
 import sys
 from pathlib import Path
 
-from clearbench.harness.cli.common import UserError, add_store_option, open_store
+from clearbench.harness.cli.common import (
+    UserError,
+    add_engine_option,
+    add_store_option,
+    open_store,
+)
 from clearbench.harness.studies.campaign.definition import (
     SHIPPED,
     CampaignError,
@@ -68,8 +73,8 @@ def _add_definition_options(parser: argparse.ArgumentParser) -> None:
                         help="campaign TOML file, or a shipped campaign: " + ", ".join(SHIPPED))
     parser.add_argument("--samples", type=int, default=None,
                         help="number of samples (overrides the file)")
-    parser.add_argument("--engine", "-e", default=None, metavar="ENGINE[PRESET]",
-                        help="engine (overrides the file)")
+    add_engine_option(parser, many=False, flags=("--engine", "-e"),
+                      help="engine (overrides the file)")
     add_store_option(parser)
 
 

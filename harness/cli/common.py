@@ -1,5 +1,6 @@
-"""What the sub-commands share: :class:`UserError` and the options of the commands that run
-engines (store, parallelism, limits, plugins).
+"""What the sub-commands share: :class:`UserError`, the ``-e`` engine option of every command
+(:func:`add_engine_option`), the options of the commands that run engines (store, parallelism,
+limits, plugins) and their progress line (:func:`progress_line`).
 
 Bad input is reported by :func:`clearbench.harness.cli.main.main` as one line on stderr with
 exit status 2: a command raises :class:`UserError` for a bad option of its own, and lets the
@@ -14,9 +15,12 @@ import os
 import sys
 from pathlib import Path
 
+from clearbench.harness.measure.headline import format_value
+from clearbench.harness.measure.verdicts import run_verdict, verdict_text
 from clearbench.harness.run.runner import Runner, default_jobs
-from clearbench.harness.run.spec import DEFAULT_TIMEOUT, parse_assignment
-from clearbench.harness.run.store import ResultsStore
+from clearbench.harness.run.spec import DEFAULT_TIMEOUT, RunSpec, parse_assignment
+from clearbench.harness.run.store import ResultsStore, RunRecord
+from clearbench.scenarios.units import TIME_UNITS
 
 
 class UserError(Exception):
@@ -53,7 +57,50 @@ def add_runner_options(parser: argparse.ArgumentParser, timeout: float = DEFAULT
     parser.add_argument("--engine-module", action="append", default=[], metavar="NAME=MODULE",
                         help="an extra engine adapter module (same contract as "
                         "clearbench.adapters), e.g. mine=my_package.my_adapter")
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.add_argument("--no-progress", action="store_true",
+                        help="no progress bar (terminal) nor progress lines (log or pipe)")
+
+
+class _AccumulateEngines(argparse.Action):
+    """Every ``-e`` adds its labels (one or several after each flag); the default is replaced
+    by the first, not extended."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        current = getattr(namespace, self.dest, None)
+        given = [] if current is None or current is self.default else list(current)
+        setattr(namespace, self.dest, [*given, *values])
+
+
+class _OneEngine(argparse.Action):
+    """A command that runs one engine: a second ``-e`` is an error (exit 2), not ignored."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        seen = f"_{self.dest}_given"
+        if getattr(namespace, seen, False):
+            parser.error(f"argument {'/'.join(self.option_strings)}: given twice "
+                         f"({getattr(namespace, self.dest)!r}, then {values!r}); this command "
+                         "runs one engine")
+        setattr(namespace, seen, True)
+        setattr(namespace, self.dest, values)
+
+
+def add_engine_option(parser: argparse.ArgumentParser, *, many: bool, default=None,
+                      help: str, flags: tuple[str, ...] = ("--engines", "-e"),
+                      dest: str | None = None) -> None:
+    """The ``-e ENGINE[PRESET]`` option of every command, one implementation.
+
+    ``many``: repeated flags accumulate (``-e a -e b`` and ``-e a b`` both give ``[a, b]``;
+    ``default`` when none is given); otherwise the command takes exactly one engine and a
+    repeated flag exits with status 2 naming both values.
+    """
+    dest = dest or ("engines" if many else "engine")
+    if many:
+        parser.add_argument(*flags, nargs="+", action=_AccumulateEngines, default=default,
+                            dest=dest, metavar="ENGINE[PRESET]",
+                            help=help + " (repeatable; each -e adds)")
+    else:
+        parser.add_argument(*flags, action=_OneEngine, default=default, dest=dest,
+                            metavar="ENGINE[PRESET]", help=help)
 
 
 def open_store(args: argparse.Namespace, create: bool = True) -> ResultsStore:
@@ -82,11 +129,42 @@ def assignments(items: list[str], option: str) -> dict:
 
 
 def make_runner(args: argparse.Namespace, store: ResultsStore, total: int) -> Runner:
+    """The runner of a command: a progress bar on stderr when it is a terminal, and one
+    :func:`progress_line` per finished run on stdout when stdout is not (a log, a pipe), for
+    commands of more than one run, unless ``--no-progress``."""
     if args.jobs is not None and args.jobs < 1:
         raise UserError(f"--jobs {args.jobs}: must be >= 1")
     if args.runs_per_worker < 1:
         raise UserError(f"--runs-per-worker {args.runs_per_worker}: must be >= 1")
-    progress = not args.no_progress and total > 1 and sys.stderr.isatty()
+    wanted = not args.no_progress and total > 1
+    lines = wanted and not sys.stdout.isatty()
     return Runner(store, jobs=args.jobs, runs_per_worker=args.runs_per_worker,
-                  progress=progress)
+                  progress=wanted and sys.stderr.isatty(),
+                  on_finished=print_progress_line if lines else None)
+
+
+def progress_line(done: int, total: int, spec: RunSpec, record: RunRecord) -> str:
+    """``[37/135] reference[default] pendulum dt=1 ms ✓ pass 1.2 s``: the run, its verdict
+    and the wall time of its worker's run phase."""
+    verdict = verdict_text(run_verdict(record.status, record.expectations_passed))
+    step = format_quantity(spec.time_step * TIME_UNITS[spec.scene.units.time], "s")
+    return (f"[{done}/{total}] {spec.engine.label} {spec.scene.name} dt={step} {verdict} "
+            f"{format_value(record.worker_seconds, 's')}")
+
+
+def print_progress_line(done: int, total: int, spec: RunSpec, record: RunRecord) -> None:
+    print(progress_line(done, total, spec, record), flush=True)
+
+
+#: SI prefixes for :func:`format_quantity`, largest first.
+_PREFIXES = ((1.0, ""), (1e-3, "m"), (1e-6, "u"), (1e-9, "n"))
+
+
+def format_quantity(value: float, unit: str) -> str:
+    """``0.001, 's'`` -> ``'1 ms'``: 3 significant digits with the largest SI prefix (down
+    to nano) that keeps the number at least 1."""
+    for factor, prefix in _PREFIXES:
+        if abs(value) >= factor:
+            return f"{value / factor:.3g} {prefix}{unit}"
+    return f"{value:.3g} {unit}"
 

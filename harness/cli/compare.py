@@ -8,6 +8,7 @@ import time
 from clearbench.harness.cli.c60 import run_c60_plan
 from clearbench.harness.cli.common import (
     UserError,
+    add_engine_option,
     add_runner_options,
     engine_modules,
     make_runner,
@@ -56,8 +57,8 @@ def register(subparsers) -> None:
 
 
 def add_compare_options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--engines", "-e", nargs="+", default=None, metavar="ENGINE[PRESET]",
-                        help="engines (default: every available engine, default preset)")
+    add_engine_option(parser, many=True,
+                      help="engines (default: every available engine, default preset)")
     parser.add_argument("--scenes", nargs="+", default=None, metavar="SCENE",
                         help="scenes (default: the library scenes tagged "
                         f"{', '.join(COMPARE_TAGS)})")

@@ -8,6 +8,7 @@ import shutil
 
 from clearbench.harness.cli.common import (
     UserError,
+    add_engine_option,
     add_runner_options,
     assignments,
     engine_modules,
@@ -15,8 +16,11 @@ from clearbench.harness.cli.common import (
     open_store,
 )
 from clearbench.harness.measure.headline import format_value
+from clearbench.harness.measure.units import unit_text
 from clearbench.harness.measure.verdicts import run_verdict, verdict_text
 from clearbench.harness.run.spec import make_run_spec
+from clearbench.scenarios.scene import Scene
+from clearbench.scenarios.units import UnitSystem
 
 
 def register(subparsers) -> None:
@@ -28,9 +32,9 @@ def register(subparsers) -> None:
         "from the store (--rerun to run it again).",
     )
     parser.add_argument("scene", help="registered scene name or scene file")
-    parser.add_argument("--engine", "-e", default="reference", metavar="ENGINE[PRESET]",
-                        help="engine and preset, e.g. reference, mujoco[elliptic] "
-                        "(default: reference)")
+    add_engine_option(parser, many=False, default="reference", flags=("--engine", "-e"),
+                      help="engine and preset, e.g. reference, mujoco[tuned] (default: "
+                      "reference)")
     parser.add_argument("--dt", type=float, default=None,
                         help="time step in the scene's time unit (default: the scene's)")
     parser.add_argument("--horizon", type=float, default=None,
@@ -69,12 +73,23 @@ def run_one(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(row, indent=2, sort_keys=True))
     else:
-        print_summary(row, from_store=spec.key in outcome.skipped, store_path=store.directory)
+        print_summary(row, from_store=spec.key in outcome.skipped, store_path=store.directory,
+                      scene=spec.scene)
     return 0 if row["status"] in ("ok", "unsupported") else 1
 
 
-def print_summary(row: dict, from_store: bool = False, store_path=None) -> None:
-    """Human-readable summary of one stored run."""
+def _figure_text(name: str, value, row: dict, scene: Scene | None) -> str:
+    """A figure with its unit (:mod:`clearbench.harness.measure.units`), or saying that it
+    has none stated there."""
+    kinds = {r.get("name"): r.get("kind") for r in json.loads(row["expectations"] or "[]")}
+    return format_value(value, unit_text(name, scene, kinds) or "(unit not stated)")
+
+
+def print_summary(row: dict, from_store: bool = False, store_path=None,
+                  scene: Scene | None = None) -> None:
+    """Human-readable summary of one stored run (``scene``: the run's scene, for the units of
+    its figures; SI when not given)."""
+    units = scene.units if scene is not None else UnitSystem()
     origin = " (from the store; --rerun to run again)" if from_store else ""
     print(f"{row['scene_name']}  {row['engine']}[{row['preset']}]  dt = {row['time_step']:g}  "
           f"horizon = {row['horizon']:g}{origin}")
@@ -91,9 +106,10 @@ def print_summary(row: dict, from_store: bool = False, store_path=None) -> None:
           "time unit)")
     figures = json.loads(row["metrics"] or "{}")
     if figures:
-        print("  metrics (scene units):")
+        print(f"  metrics (units {units.length}-{units.mass}-{units.time}, force "
+              f"{units.force_unit()}; a ratio says what it is of):")
         for name in sorted(figures):
-            print(f"    {name:<36} {format_value(figures[name])}")
+            print(f"    {name:<36} {_figure_text(name, figures[name], row, scene)}")
     if row["error_source"]:
         print(f"  error measured against: {row['error_source']}")
     expectations = json.loads(row["expectations"] or "[]")

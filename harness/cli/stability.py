@@ -6,12 +6,14 @@ import argparse
 
 from clearbench.harness.cli.common import (
     UserError,
+    add_engine_option,
     add_runner_options,
     engine_modules,
     make_runner,
     open_store,
 )
 from clearbench.harness.measure.headline import METRIC_LABELS, format_value
+from clearbench.harness.measure.units import unit_text
 from clearbench.harness.measure.verdicts import run_verdict, verdict_text
 from clearbench.harness.studies.stability import (
     STIFF_TAG,
@@ -31,8 +33,8 @@ def register(subparsers) -> None:
         "(pass / physics failed / diverged / crashed / timed out / unsupported) with the metrics "
         "of the case.",
     )
-    parser.add_argument("--engines", "-e", nargs="+", default=None, metavar="ENGINE[PRESET]",
-                        help="engines (default: every available engine, default preset)")
+    add_engine_option(parser, many=True,
+                      help="engines (default: every available engine, default preset)")
     parser.add_argument("--scenes", nargs="+", default=None, metavar="SCENE",
                         help=f"only these cases (default: every scene tagged {STIFF_TAG!r})")
     add_runner_options(parser, timeout=300.0)
@@ -51,14 +53,17 @@ def run_stability(args: argparse.Namespace) -> int:
     outcome = runner.run_all(specs, rerun=args.rerun)
     print(f"{len(outcome.ran)} runs done, {len(outcome.skipped)} already in {store.directory}")
     rows = stability_rows(store.dataframe(), specs)
+    scenes = {spec.scene.name: spec.scene for spec in specs}
     case = None
     for row in rows:
         if row["case"] != case:
             case = row["case"]
             print(f"\n{case}: {row['summary']}")
         verdict = verdict_text(run_verdict(row["status"], row["expectations_passed"]))
-        figures = ", ".join(f"{METRIC_LABELS.get(n, (n,))[0]} {format_value(v)}"
-                            for n, v in row["metrics"].items())
+        scene = scenes.get(row["case"])
+        figures = ", ".join(
+            f"{METRIC_LABELS.get(n, (n,))[0]} {format_value(v, unit_text(n, scene, short=True))}"
+            for n, v in row["metrics"].items())
         print(f"  {row['engine']:<24} {verdict}")
         if row["reason"] and row["status"] != "ok":
             print(f"  {'':<24} {row['reason']}")

@@ -6,6 +6,7 @@ import argparse
 
 from clearbench.harness.cli.common import (
     UserError,
+    add_engine_option,
     add_runner_options,
     assignments,
     engine_modules,
@@ -40,8 +41,8 @@ def register(subparsers) -> None:
     parser.add_argument("scenes", nargs="*", metavar="SCENE",
                         help="registered scene names or scene files")
     parser.add_argument("--tag", help="add every registered scene with this tag")
-    parser.add_argument("--engines", "-e", nargs="+", default=["reference"],
-                        metavar="ENGINE[PRESET]", help="engines (default: reference)")
+    add_engine_option(parser, many=True, default=["reference"],
+                      help="engines (default: reference)")
     parser.add_argument("--dt", default=DEFAULT_LADDER, metavar="LADDER",
                         help="comma-separated time steps; a trailing x means times the scene's "
                         f"comfortable step (default {DEFAULT_LADDER})")

@@ -30,6 +30,7 @@ from clearbench.harness.measure.headline import (
     headline,
     scene_metric_names,
 )
+from clearbench.harness.measure.units import unit_text
 from clearbench.harness.measure.verdicts import VERDICTS, run_verdict, verdict_text
 from clearbench.harness.report.c60_section import C60Section, build_section
 from clearbench.harness.report.c60_section import section_html as c60_engines_html
@@ -45,8 +46,6 @@ from clearbench.scenarios.scene import Scene
 LOG = logging.getLogger(__name__)
 
 FINE_SUFFIX = ":fine-reference"
-STATUS_COLOURS = {"ok": "#d9f2d9", "diverged": "#f8d0d0", "crashed": "#f4b6b6",
-                  "timed_out": "#fbe3b8", "unsupported": "#e4e4e4"}
 
 
 @dataclass
@@ -152,12 +151,23 @@ def _cell(row: dict | None, scene: Scene | None) -> tuple[str, str, str]:
     figures = json.loads(row["metrics"] or "{}")
     name, value = headline(scene, figures) if scene is not None else ("", math.nan)
     label = METRIC_LABELS.get(name, (name, ""))[0]
-    text = f"{label} {format_value(value)}" if name else ""
+    text = f"{label} {format_value(value, unit_text(name, scene, short=True))}" if name else ""
+    return run_verdict(row["status"], row.get("expectations_passed")), text, _run_title(row)
+
+
+def _run_title(row) -> str:
+    """The run's message and its failed expectations (a verdict cell's title)."""
     failed = [r["name"] for r in json.loads(row.get("expectations") or "[]")
               if r.get("passed") is False]
-    title = "; ".join(filter(None, [row.get("message") or "",
-                                    f"failed: {', '.join(failed)}" if failed else ""]))
-    return run_verdict(row["status"], row.get("expectations_passed")), text, title
+    return "; ".join(filter(None, [row.get("message") or "",
+                                   f"failed: {', '.join(failed)}" if failed else ""]))
+
+
+def _column_head(name: str, scene: Scene | None) -> str:
+    """A metric column's header: its label and its unit (``penetration [mm]``)."""
+    unit = unit_text(name, scene, short=True)
+    label = METRIC_LABELS.get(name, (name,))[0]
+    return f"{label} [{unit}]" if unit else label
 
 
 def _metric_columns(section: SceneSection) -> list[str]:
@@ -213,22 +223,28 @@ def _esc(value) -> str:
     return html.escape(str(value))
 
 
-def _status_td(status: str, text: str = "", title: str = "") -> str:
-    colour = STATUS_COLOURS.get(status, "#ffffff")
-    body = f"<span class='status'>{_esc(status)}</span>" if status else ""
-    if text:
-        body += f"<br><span class='small'>{_esc(text)}</span>"
-    return f"<td style='background:{colour}' title='{_esc(title)}'>{body}</td>"
-
-
-def _verdict_td(verdict: str, text: str, title: str, scene: str, engine: str) -> str:
-    """An overview cell: the verdict's colour, symbol and name, the headline figure under it;
-    ``data-*`` attributes name the scene, engine and verdict for tools reading the page."""
+def _verdict_body(verdict: str, text: str) -> tuple[str, str]:
+    """(background colour, cell content) of a verdict cell: symbol and name, ``text`` under
+    it."""
     style = VERDICTS.get(verdict)
     colour = style.colour if style else "#ffffff"
     body = f"<span class='status'>{_esc(verdict_text(verdict))}</span>" if style else ""
     if text:
         body += f"<br><span class='small'>{_esc(text)}</span>"
+    return colour, body
+
+
+def _run_verdict_td(run) -> str:
+    """A per-scene table's verdict cell: the run's verdict (status and expectations together,
+    as in the overview), its colour, and the message and failed expectations as its title."""
+    colour, body = _verdict_body(run_verdict(run["status"], run["expectations_passed"]), "")
+    return f"<td style='background:{colour}' title='{_esc(_run_title(run))}'>{body}</td>"
+
+
+def _verdict_td(verdict: str, text: str, title: str, scene: str, engine: str) -> str:
+    """An overview cell: the verdict's colour, symbol and name, the headline figure under it;
+    ``data-*`` attributes name the scene, engine and verdict for tools reading the page."""
+    colour, body = _verdict_body(verdict, text)
     return (f"<td class='verdict' data-scene='{_esc(scene)}' data-engine='{_esc(engine)}' "
             f"data-verdict='{_esc(verdict or 'not run')}' style='background:{colour}' "
             f"title='{_esc(title)}'>{body}</td>")
@@ -269,7 +285,7 @@ def _overview_html(data: ReportData, stiff: bool) -> str:
 
 def _runs_table_html(section: SceneSection) -> str:
     columns = _metric_columns(section)
-    head = "".join(f"<th>{_esc(METRIC_LABELS.get(c, (c,))[0])}</th>" for c in columns)
+    head = "".join(f"<th>{_esc(_column_head(c, section.scene))}</th>" for c in columns)
     rows = []
     for _, run in section.runs.sort_values(["label", "time_step"]).iterrows():
         figures = json.loads(run["metrics"] or "{}")
@@ -281,7 +297,7 @@ def _runs_table_html(section: SceneSection) -> str:
             else ("pass" if int(passed) else "FAIL")
         rows.append(
             f"<tr><td>{_esc(run['label'] + role)}</td><td class='num'>{run['time_step']:.3g}"
-            f"</td>{_status_td(run['status'], '', run['message'] or '')}<td>{mark}</td>{cells}"
+            f"</td>{_run_verdict_td(run)}<td>{mark}</td>{cells}"
             f"<td class='num'>{_esc(format_value(run['stepping_seconds_per_step'], 's'))}</td>"
             f"<td class='num'>"
             f"{_esc(format_value(run['stepping_seconds_per_simulated_second'], 's'))}</td></tr>")
@@ -487,12 +503,13 @@ def render_markdown(data: ReportData, figure_files: dict, c60_figure_files: dict
         columns = _metric_columns(section)
         lines += [f"### {section.name}", "",
                   "| engine | dt | verdict | " + " | ".join(
-                      METRIC_LABELS.get(c, (c,))[0] for c in columns) + " | stepping/step |",
+                      _column_head(c, section.scene) for c in columns) + " | stepping/step |",
                   "|---|---|---|" + "---|" * len(columns) + "---|"]
         for _, run in section.runs.sort_values(["label", "time_step"]).iterrows():
             figures = json.loads(run["metrics"] or "{}")
             role = " (fine ref)" if str(run["campaign"]).endswith(FINE_SUFFIX) else ""
-            lines.append(f"| {run['label']}{role} | {run['time_step']:.3g} | {run['status']} | "
+            verdict = verdict_text(run_verdict(run["status"], run["expectations_passed"]))
+            lines.append(f"| {run['label']}{role} | {run['time_step']:.3g} | {verdict} | "
                          + " | ".join(format_value(figures.get(c)) for c in columns)
                          + f" | {format_value(run['stepping_seconds_per_step'], 's')} |")
         for title, path in figure_files.get(section.name, {}).items():

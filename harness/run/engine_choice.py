@@ -5,8 +5,8 @@ An engine is found through :data:`clearbench.adapters.ENGINES`, or through extra
 modules given by the caller (``{"mine": "my_package.my_adapter"}``), which follow the same
 contract (:mod:`clearbench.adapters.base`): ``availability() -> (bool, str)`` and
 ``create(preset) -> Engine``. The preset and the option names are checked by the engine itself
-(``create`` refuses an unknown preset, ``Engine.check_options`` unknown options), here turned
-into input errors naming the field.
+(``create`` refuses an unknown preset, ``Engine.check_options`` unknown options and values its
+declaration refuses), here turned into input errors naming the field.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 from clearbench.adapters import ENGINES, engine_availability
+from clearbench.adapters.options import OptionError
 
 _LABEL = re.compile(r"^\s*([A-Za-z0-9_.-]+)\s*(?:\[\s*([A-Za-z0-9_.+-]*)\s*\])?\s*$")
 
@@ -74,7 +75,7 @@ def resolve_engine(text: str, extra_modules: Mapping[str, str] | None = None,
     Raises
     ------
     RunInputError
-        Unknown engine, engine not available here, unknown preset or option.
+        Unknown engine, engine not available here, unknown preset or option, bad option value.
     """
     name, preset = parse_engine_label(text, field)
     module_path = engine_module_path(name, extra_modules)
@@ -101,15 +102,22 @@ def resolve_engine(text: str, extra_modules: Mapping[str, str] | None = None,
 
 
 def check_options(choice: EngineChoice, options: Mapping | None) -> None:
-    """RunInputError when the engine of ``choice`` does not have an option of ``options``."""
+    """RunInputError when the engine of ``choice`` does not have an option of ``options`` or
+    refuses its value."""
     if options:
         engine = importlib.import_module(choice.module).create(choice.preset)
         _check_engine_options(engine, options)
 
 
 def _check_engine_options(engine, options: Mapping | None) -> None:
-    """The engine's own option check (``Engine.check_options``) as an input error."""
+    """The engine's own option check (``Engine.check_options``: names, types, ranges and
+    allowed values from its declaration, :mod:`clearbench.adapters.options`) as an input
+    error naming the engine, the option and the value."""
     try:
         engine.check_options(options)
-    except ValueError as error:
-        raise RunInputError("options", ", ".join(sorted(options or {})), str(error)) from None
+    except OptionError as error:
+        raise RunInputError(f"{error.engine} option {error.name}", error.value,
+                            error.reason) from None
+    except ValueError as error:  # an engine outside the package with its own check
+        raise RunInputError(f"{engine.name} options", dict(options or {}), str(error)) \
+            from None

@@ -10,7 +10,8 @@ sentinels, so that
 
 and the parent carries on with the rest of the sweep. A run is written to the results store only
 once complete (outcome and metrics), in one transaction, under its deterministic key; runs whose
-key is already in the store are skipped, so a sweep interrupted even by ``kill -9`` resumes
+key is already in the store are skipped (served from it), except crashed ones, which are run
+again (:data:`~.store.RERUN_STATUSES`), so a sweep interrupted even by ``kill -9`` resumes
 without losing or duplicating runs.
 """
 
@@ -23,7 +24,7 @@ import os
 import signal
 import time
 from collections import deque
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -110,16 +111,22 @@ class Runner:
         Variables set in the workers' environment over this process's own (e.g.
         ``{"NUMBA_CPU_NAME": "generic"}``; :func:`worker_environment`). None: the workers
         inherit this process's environment unchanged.
+    on_finished : callable, optional
+        Called after each run is recorded as ``on_finished(done, total, spec, record)``:
+        ``done`` runs of the ``total`` this :meth:`run_all` call runs (those served from the
+        store not counted). The CLI prints a progress line with it.
     """
 
     def __init__(self, store: ResultsStore, jobs: int | None = None, runs_per_worker: int = 1,
                  progress: bool = False, measure_timeout: float = MEASURE_TIMEOUT,
-                 environment: Mapping[str, str] | None = None):
+                 environment: Mapping[str, str] | None = None,
+                 on_finished: Callable[[int, int, RunSpec, RunRecord], None] | None = None):
         self.store = store
         self.environment = worker_environment(environment)
         self.jobs = max(1, int(jobs or default_jobs()))
         self.runs_per_worker = max(1, int(runs_per_worker))
         self.progress = progress
+        self.on_finished = on_finished
         self.measure_timeout = measure_timeout
         self._context = multiprocessing.get_context("spawn")
         self._slots: list[_Slot] = []
@@ -168,14 +175,15 @@ class Runner:
 
     # ------------------------------------------------------------------ running
     def run_all(self, jobs: Iterable[RunJob | RunSpec], rerun: bool = False) -> SweepOutcome:
-        """Run every job whose key is not yet in the store (all of them with ``rerun``).
+        """Run every job whose key is not yet in the store, or stored as crashed
+        (:data:`~.store.RERUN_STATUSES`; every job with ``rerun``).
 
         Jobs with the same key are run once. Returns what was run and what was skipped.
         """
         outcome = SweepOutcome()
         queue: deque[RunJob] = deque()
         seen: set[str] = set()
-        stored = self.store.keys()
+        stored = self.store.reusable_keys()
         for job in jobs:
             job = job if isinstance(job, RunJob) else RunJob(job)
             key = job.spec.key
@@ -194,7 +202,7 @@ class Runner:
 
             bar = tqdm(total=len(queue), unit="run", desc="runs", leave=False)
         try:
-            self._loop(queue, outcome, bar, rerun)
+            self._loop(queue, outcome, bar)
         finally:
             if bar is not None:
                 bar.close()
@@ -217,7 +225,8 @@ class Runner:
         slot.deadline = slot.started + spec.timeout
         slot.conn.send(request)
 
-    def _loop(self, queue: deque, outcome: SweepOutcome, bar, rerun: bool) -> None:
+    def _loop(self, queue: deque, outcome: SweepOutcome, bar) -> None:
+        total = len(queue)
         while queue or any(s.job is not None for s in self._slots):
             # fill idle slots
             while queue and (len(self._slots) < self.jobs
@@ -235,7 +244,9 @@ class Runner:
             for slot in busy:
                 finished = self._service(slot)
                 if finished is not None:
-                    record = self._finish(slot, finished, outcome, rerun)
+                    record = self._finish(slot, finished, outcome)
+                    if self.on_finished is not None:
+                        self.on_finished(len(outcome.ran), total, finished.spec, record)
                     if bar is not None:
                         bar.update(1)
                         bar.set_postfix_str(f"{finished.spec.label}: {record.status}",
@@ -288,8 +299,7 @@ class Runner:
         self._slots.remove(slot)
         return finished
 
-    def _finish(self, slot: _Slot, finished: _Finished, outcome: SweepOutcome,
-                rerun: bool) -> RunRecord:
+    def _finish(self, slot: _Slot, finished: _Finished, outcome: SweepOutcome) -> RunRecord:
         spec = finished.spec
         if finished.worker_ok:
             slot.job = None
@@ -300,7 +310,8 @@ class Runner:
                                        self._revision, self._machine)
         tmp = finished.trajectory_tmp
         saved = bool(finished.ran.get("trajectory_saved")) and tmp is not None and tmp.exists()
-        self.store.record(record, trajectory_file=tmp if saved else None, replace=rerun,
+        # Replacing: a rerun, or a run stored as crashed that was run again.
+        self.store.record(record, trajectory_file=tmp if saved else None, replace=True,
                           scene=spec.scene)
         if tmp is not None and tmp.exists():
             tmp.unlink()

@@ -37,6 +37,13 @@ from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.serialization import scene_from_dict, scene_to_dict
 
 SCHEMA_VERSION = 1
+#: Stored outcomes that are run again when asked for, rather than served from the store. A
+#: crash is not always a property of the run: a worker killed from outside (out of memory, a
+#: signal), an engine's interpreter failing to start, an input no check caught; served, it
+#: would stand until the code changes. Rerunning it costs little (most crashes happen while
+#: building or in the first steps) and gives the same record when the crash is the engine's.
+#: A time-out is served: it costs the whole wall-clock limit each time (``--rerun`` asks).
+RERUN_STATUSES = (RunStatus.CRASHED.value,)
 DATABASE = "runs.sqlite"
 TRAJECTORIES = "trajectories"
 
@@ -284,6 +291,14 @@ class ResultsStore:
     def keys(self) -> set[str]:
         with self._connect() as connection:
             return {row[0] for row in connection.execute("SELECT key FROM runs")}
+
+    def reusable_keys(self) -> set[str]:
+        """Keys of the runs a sweep may serve from the store instead of running them: every
+        run but a crashed one (:data:`RERUN_STATUSES`)."""
+        marks = ", ".join("?" for _ in RERUN_STATUSES)
+        with self._connect() as connection:
+            return {row[0] for row in connection.execute(
+                f"SELECT key FROM runs WHERE status NOT IN ({marks})", RERUN_STATUSES)}
 
     def __len__(self) -> int:
         with self._connect() as connection:
