@@ -261,7 +261,6 @@ def _body_map(mbs, scene: Scene, nodes: dict[str, int], rotation_coordinates: st
         return BodyMap(movable, None, None, fixed_pose, com, node_numbers)
     index = -np.ones((nb, 7), dtype=np.int64)
     reference = np.zeros((nb, 7))
-    fixed_pose = np.zeros((nb, 7))
     reference_q = mbs.systemData.GetODE2Coordinates(configuration=exu.ConfigurationType.Reference)
     for i, body in enumerate(scene.bodies):
         if body.name in nodes:
