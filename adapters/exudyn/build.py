@@ -34,7 +34,7 @@ from clearbench.adapters.exudyn.settings import (
     exudyn_restitution,
 )
 from clearbench.adapters.force_elements import ForceElements
-from clearbench.kernels.quaternion import quat_to_matrix
+from clearbench.kernels.quaternion import quat_to_matrix, quat_to_matrix_batch
 from clearbench.kernels.time_profiles import profile_integral, profile_value
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.joints import (
@@ -69,6 +69,11 @@ def load_exudyn():
     return exudyn
 
 
+#: Option ``rotation_coordinates`` -> Exudyn's rigid-body node type.
+NODE_TYPES = {"euler_parameters": "RotationEulerParameters",
+              "rotation_vector": "RotationRotationVector",
+              "tait_bryan": "RotationRxyz"}
+
 #: Components of a driver -> index in an ObjectJointGeneric (translations 0-2, rotations 3-5).
 DRIVER_AXES = {"x": 0, "y": 1, "z": 2, "rx": 3, "ry": 4, "rz": 5}
 
@@ -90,9 +95,10 @@ class BodyMap:
     Attributes
     ----------
     movable : (nb,) bool
-    coordinate_index : (nb, 7) int
+    coordinate_index : (nb, 7) int or None
         ODE2 indices of each movable body's node (x, y, z, e0, e1, e2, e3); -1 for fixed.
-    reference : (nb, 7) float
+        None for nodes of other rotation coordinates (read through :meth:`node_state`).
+    reference : (nb, 7) float or None
         Reference coordinates of the nodes (the ODE2 coordinates are displacements from them).
     fixed_pose : (nb, 7) float
         Position and quaternion of fixed bodies.
@@ -105,6 +111,32 @@ class BodyMap:
     reference: np.ndarray
     fixed_pose: np.ndarray
     com: np.ndarray
+    nodes: np.ndarray | None = None  # (nb,) Exudyn node numbers, -1 for fixed bodies
+
+    @property
+    def euler_parameters(self) -> bool:
+        """True when the nodes' coordinates are Euler parameters (read from the coordinate
+        vectors directly)."""
+        return self.coordinate_index is not None
+
+    def node_state(self, mbs) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Origins (nb, 3), rotations (nb, 3, 3), centre-of-mass velocities (nb, 3, world) and
+        body-axis angular velocities (nb, 3) of the current configuration, through Exudyn's
+        node outputs (any rotation coordinates)."""
+        output = load_exudyn().OutputVariableType
+        nb = self.movable.shape[0]
+        position = self.fixed_pose[:, :3].copy()
+        rotation = quat_to_matrix_batch(self.fixed_pose[:, 3:])
+        velocity = np.zeros((nb, 3))
+        omega = np.zeros((nb, 3))
+        for b in np.flatnonzero(self.movable):
+            node = int(self.nodes[b])
+            position[b] = mbs.GetNodeOutput(node, output.Position)
+            rotation[b] = np.reshape(mbs.GetNodeOutput(node, output.RotationMatrix), (3, 3))
+            omega[b] = mbs.GetNodeOutput(node, output.AngularVelocityLocal)
+            velocity[b] = (np.asarray(mbs.GetNodeOutput(node, output.Velocity))
+                           + rotation[b] @ np.cross(omega[b], self.com[b]))
+        return position, rotation, velocity, omega
 
     def poses(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Body-frame origins (nb, 3) and unit quaternions (nb, 4) from ODE2 coordinates."""
@@ -194,6 +226,7 @@ def build_system(scene: Scene, settings: ExudynSettings, time_step: float) -> Bu
             body.mass, np.asarray(body.inertia, dtype=float), com, inertiaTensorAtCOM=True)
         created = mbs.CreateRigidBody(
             name=body.name, inertia=inertia, referencePosition=position,
+            nodeType=getattr(exu.NodeType, NODE_TYPES[settings.rotation_coordinates]),
             referenceRotationMatrix=rotation, initialVelocity=list(origin_velocity),
             initialAngularVelocity=list(omega_world), gravity=gravity, show=False,
             returnDict=True)
@@ -207,29 +240,33 @@ def build_system(scene: Scene, settings: ExudynSettings, time_step: float) -> Bu
     _add_loads(built, scene, settings)
     _add_drivers(built, scene, settings)
     mbs.Assemble()
-    built.bodies = _body_map(mbs, scene, nodes)
+    built.bodies = _body_map(mbs, scene, nodes, settings.rotation_coordinates)
     for ref in built.connectors:  # data coordinate of each connector's gap
         ref.data_index = int(mbs.systemData.GetNodeLTGData(ref.data_index)[0])
     return built
 
 
-def _body_map(mbs, scene: Scene, nodes: dict[str, int]) -> BodyMap:
+def _body_map(mbs, scene: Scene, nodes: dict[str, int], rotation_coordinates: str) -> BodyMap:
     exu = load_exudyn()
     nb = len(scene.bodies)
     movable = np.array([b.motion is not Motion.FIXED for b in scene.bodies])
-    index = -np.ones((nb, 7), dtype=np.int64)
-    reference = np.zeros((nb, 7))
+    node_numbers = np.array([nodes.get(b.name, -1) for b in scene.bodies], dtype=np.int64)
+    com = np.array([b.center_of_mass for b in scene.bodies], dtype=float).reshape(nb, 3)
     fixed_pose = np.zeros((nb, 7))
-    reference_q = mbs.systemData.GetODE2Coordinates(configuration=exu.ConfigurationType.Reference)
     for i, body in enumerate(scene.bodies):
         q = np.asarray(body.orientation, dtype=float)
         fixed_pose[i, :3] = body.position
         fixed_pose[i, 3:] = q / np.linalg.norm(q)
+    if rotation_coordinates != "euler_parameters":
+        return BodyMap(movable, None, None, fixed_pose, com, node_numbers)
+    index = -np.ones((nb, 7), dtype=np.int64)
+    reference = np.zeros((nb, 7))
+    reference_q = mbs.systemData.GetODE2Coordinates(configuration=exu.ConfigurationType.Reference)
+    for i, body in enumerate(scene.bodies):
         if body.name in nodes:
             index[i] = mbs.systemData.GetNodeLTGODE2(nodes[body.name])
             reference[i] = reference_q[index[i]]
-    com = np.array([b.center_of_mass for b in scene.bodies], dtype=float).reshape(nb, 3)
-    return BodyMap(movable, index, reference, fixed_pose, com)
+    return BodyMap(movable, index, reference, fixed_pose, com, node_numbers)
 
 
 # ---------------------------------------------------------------------------- joints

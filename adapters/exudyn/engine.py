@@ -137,11 +137,17 @@ def _metadata(scene: Scene, internal: Scene, config: ExudynSettings, built, runn
         "clearance_joints": clearance_summary(scene, config),
         "warnings": list(built.warnings),
         "guards": runner.guard_notes,
+        "force_scale": runner.force_scale_value,
+        "newton_absolute_tolerance": runner.newton_absolute_tolerance,
         "solver_steps": runner.solver_steps,
         "nominal_steps": runner.steps,
         "reduced_steps": max(0, runner.solver_steps - int(round(last_time / built.time_step))),
         "discontinuous_iteration_failures": runner.discontinuous_failures_total,
         "solver_error": runner.error_string,
+        "failed_loop": runner.failed_loop,
+        # Exudyn's GetErrorString as it is: its Newton and discontinuous-iteration flags are
+        # printed inverted (see adapters/exudyn/failure.py).
+        "exudyn_error_string": runner.exudyn_error_string,
         "captured_stdout": runner.captured_stdout[-2000:],
         "energy_initial": runner.guard.energy_initial,
         "energy_max_gain": runner.guard.max_gain,

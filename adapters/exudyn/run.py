@@ -21,7 +21,9 @@ Guards:
   ``sys.stdout`` redirected during the solve; anything caught goes to the metadata;
 - solver failure: ``SolveSteps`` returning False or raising ``SolverError`` /
   ``ExudynError`` (Newton failure after the step reductions, singular Jacobian) stops the run
-  as DIVERGED with Exudyn's error string (CRASHED for other exceptions);
+  as DIVERGED with the reason read from the solver's flags (:mod:`.failure`: which of Newton,
+  the discontinuous iteration or step reduction failed, step size, residual; CRASHED for other
+  exceptions);
 - non-finite state, and energy gain on scenes whose energy may not grow
   (:class:`~clearbench.adapters.energy_guard.EnergyGuard`, shared): DIVERGED.
 """
@@ -37,12 +39,13 @@ import numpy as np
 
 from clearbench.adapters.energy_guard import SPRING_WORK_FEATURES, EnergyGuard
 from clearbench.adapters.exudyn.build import BuiltSystem, load_exudyn
+from clearbench.adapters.exudyn.failure import failed_loop, failure_reason
 from clearbench.adapters.exudyn.settings import ExudynSettings
 from clearbench.adapters.recording import SampleRecorder
 from clearbench.adapters.trajectory import RunStatus
-from clearbench.kernels.quaternion import quat_to_matrix_batch
+from clearbench.kernels.quaternion import quat_from_matrix_batch, quat_to_matrix_batch
 from clearbench.scenarios.bodies import Motion
-from clearbench.scenarios.loads import LinearSpringDamper
+from clearbench.scenarios.loads import LinearSpringDamper, PointForce
 from clearbench.scenarios.scene import Scene
 
 logger = logging.getLogger(__name__)
@@ -108,6 +111,11 @@ class Runner:
         self.problem: str | None = None
         self.captured_stdout = ""
         self.error_string = ""
+        self.exudyn_error_string = ""
+        self.force_scale_value: float | None = None
+        self._call_start = False
+        self.newton_absolute_tolerance = config.newton_absolute_tolerance
+        self.failed_loop = ""
         self.mass = np.array([b.mass for b in scene.bodies])
         self.inertia = np.array([np.asarray(b.inertia, dtype=float) for b in scene.bodies])
         self.movable = np.array([b.motion is not Motion.FIXED for b in scene.bodies])
@@ -129,10 +137,13 @@ class Runner:
     def state(self):
         """Origins (nb, 3), quaternions (nb, 4), rotations (nb, 3, 3), centre-of-mass
         velocities (nb, 3) and body-axis angular velocities (nb, 3) of the current state."""
+        bodies = self.built.bodies
+        if not bodies.euler_parameters:
+            position, rotation, velocity, omega = bodies.node_state(self.built.mbs)
+            return position, quat_from_matrix_batch(rotation), rotation, velocity, omega
         data = self.built.mbs.systemData
         q = np.asarray(data.GetODE2Coordinates())
         q_t = np.asarray(data.GetODE2Coordinates_t())
-        bodies = self.built.bodies
         position, quaternion = bodies.poses(q)
         rotation = quat_to_matrix_batch(quaternion)
         velocity, omega = bodies.velocities(q, q_t, rotation)
@@ -153,6 +164,26 @@ class Runner:
             stretch = np.linalg.norm(pb - pa) - load.rest_length
             springs += load.preload * stretch + 0.5 * load.stiffness * stretch**2
         return float(kinetic + potential + springs), float(kinetic)
+
+    def force_scale(self, state=None) -> float:
+        """The scene's force scale [F, model units]: the largest applied force in the current
+        configuration (weights, point forces, linear springs with their preload, the forces of
+        the law loads); moments are left out (a moment has no force scale without a lever)."""
+        position, _, rotation, _, _ = state or self.state()
+        forces = [self.mass[self.movable] * float(np.linalg.norm(self.gravity))]
+        forces += [[float(np.linalg.norm(load.force))] for load in self.scene.loads
+                   if isinstance(load, PointForce)]
+        for load, a, b in self._springs:
+            pa = position[a] + rotation[a] @ np.asarray(load.point_a)
+            pb = position[b] + rotation[b] @ np.asarray(load.point_b)
+            stretch = np.linalg.norm(pb - pa) - load.rest_length
+            forces.append([abs(load.preload + load.stiffness * stretch)])
+        laws = self.built.law_forces
+        if laws is not None:
+            com = position + np.einsum("bij,bj->bi", rotation, self.built.bodies.com)
+            wrench = laws.wrenches(0.0, com, rotation)
+            forces.append(np.linalg.norm(wrench[:, :3], axis=1))
+        return float(max((np.max(f, initial=0.0) for f in forces), default=0.0))
 
     # ------------------------------------------------------------------ read-out
     def contact_forces(self) -> tuple[np.ndarray, np.ndarray, int]:
@@ -207,7 +238,18 @@ class Runner:
 
     # ------------------------------------------------------------------ user functions
     def _pre_step(self, mbs, t: float) -> bool:
+        if self._call_start:
+            self._call_start = False
+            solver = self._solver
+            if self.config.keep_jacobian and solver is not None and \
+                    int(solver.it.newtonJacobiCount) > 0:
+                # SolveSteps requests a Jacobian at the start of every call; the grid loop's
+                # calls continue one run, so the previous call's Jacobian is kept, as within
+                # one call (modified Newton updates it when it stops contracting).
+                solver.conv.jacobianUpdateRequested = False
         laws = self.built.law_forces
+        if laws is None or self.config.law_loads != "explicit":
+            return True
         position, _, rotation, _, _ = self.state()
         com = position + np.einsum("bij,bj->bi", rotation, self.built.bodies.com)
         wrench = laws.wrenches(t, com, rotation)
@@ -221,8 +263,7 @@ class Runner:
         q = np.asarray(mbs.systemData.GetODE2Coordinates())
         key = q.tobytes()
         if self._law_cache is None or self._law_cache[0] != key:
-            position, quaternion = self.built.bodies.poses(q)
-            rotation = quat_to_matrix_batch(quaternion)
+            position, _, rotation, _, _ = self.state()
             com = position + np.einsum("bij,bj->bi", rotation, self.built.bodies.com)
             self._law_cache = (key, self.built.law_forces.wrenches(t, com, rotation))
         return self._law_cache[1]
@@ -257,8 +298,11 @@ class Runner:
                 .all()):
             problem = f"non-finite state at t = {t:.6g}"
         if self.built.law_forces is not None:
-            _, quaternion = self.built.bodies.poses(q)
-            self.built.law_forces.remember(quat_to_matrix_batch(quaternion))
+            if self.built.bodies.euler_parameters:
+                rotation = quat_to_matrix_batch(self.built.bodies.poses(q)[1])
+            else:
+                rotation = self.state()[2]
+            self.built.law_forces.remember(rotation)
         recording = (self.count < len(self.record_times)
                      and t >= self.record_times[self.count] - 1e-6 * self.dt)
         checking = self.guard.due(self.solver_steps)
@@ -284,14 +328,20 @@ class Runner:
             self.guard_notes.append("closed loop: EigenDense full-pivot LU with "
                                     "ignoreSingularJacobian (redundant constraints)")
         state = self.state()
+        if self.config.newton_force_tolerance is not None:
+            self.force_scale_value = self.force_scale(state)
+            if self.force_scale_value > 0.0:
+                s.timeIntegration.newton.absoluteTolerance = (
+                    self.config.newton_force_tolerance * self.force_scale_value)
+        self.newton_absolute_tolerance = s.timeIntegration.newton.absoluteTolerance
         self.guard.start(*self.energy(state))
         self.store(0.0, state, with_contacts=False)
         mbs.SetPostStepUserFunction(self._post_step)
-        if self.built.law_forces is not None:
-            if self.config.law_loads == "explicit":
-                mbs.SetPreStepUserFunction(self._pre_step)
-            else:
-                self._install_implicit_laws()
+        if self.built.law_forces is not None and self.config.law_loads == "implicit":
+            self._install_implicit_laws()
+        if (self.built.law_forces is not None and self.config.law_loads == "explicit") or (
+                self.config.keep_jacobian and self.config.step_loop == "grid"):
+            mbs.SetPreStepUserFunction(self._pre_step)
         solver = exu.MainSolverImplicitSecondOrder()
         self._solver = solver
         previous = exu.config.printToConsole
@@ -311,6 +361,7 @@ class Runner:
                     success = True
                     for step in range(1, self.steps + 1):
                         solver.it.endTime = step * self.dt
+                        self._call_start = True
                         success = solver.SolveSteps(mbs, s)
                         if not success or self.problem is not None:
                             break
@@ -318,18 +369,16 @@ class Runner:
             if self.problem is not None:
                 status, message = RunStatus.DIVERGED, self.problem
             elif not success:
-                self.error_string = solver.GetErrorString()
+                self._read_failure(solver, s)
                 status = RunStatus.DIVERGED
                 message = (f"Exudyn solver failed at t = {mbs.systemData.GetTime():.6g}: "
-                           f"{self.error_string or 'SolveSteps returned False'}"
-                           + self._failure_flags(solver))
+                           f"{self.error_string}")
         except exu.ExudynError as error:  # SolverError and the other Exudyn errors
-            self.error_string = solver.GetErrorString()
+            self._read_failure(solver, s)
             status = RunStatus.DIVERGED if isinstance(error, exu.SolverError) \
                 else RunStatus.CRASHED
             message = (f"Exudyn {type(error).__name__} at t = {mbs.systemData.GetTime():.6g}: "
-                       f"{error}" + (f" ({self.error_string})" if self.error_string else "")
-                       + self._failure_flags(solver))
+                       f"{error} ({self.error_string})")
         except Exception as error:  # a Python user function or the adapter itself
             status = RunStatus.CRASHED
             message = f"{type(error).__name__}: {error}"
@@ -346,10 +395,10 @@ class Runner:
             logger.info("%s: stopped: %s", self.scene.name, message)
         return status, message
 
-    @staticmethod
-    def _failure_flags(solver) -> str:
-        conv = solver.conv
-        flags = [name for name in ("newtonSolutionDiverged", "stepReductionFailed",
-                                   "linearSolverFailed", "massMatrixNotInvertible")
-                 if getattr(conv, name)]
-        return f" [{', '.join(flags)}]" if flags else ""
+    def _read_failure(self, solver, simulation) -> None:
+        """The failure's reason from the solver's flags (:mod:`.failure`; Exudyn's own error
+        string, whose Newton and discontinuous-iteration flags are printed inverted, is kept
+        as it is in ``exudyn_error_string``)."""
+        self.exudyn_error_string = solver.GetErrorString()
+        self.failed_loop = failed_loop(solver.conv)
+        self.error_string = failure_reason(solver, simulation)

@@ -55,7 +55,19 @@ PRESETS: dict[str, dict] = {
     },
 }
 
+# Mechanisms with clearance joints and friction latches (the C-60): 'tuned' with Newton's
+# absolute tolerance scaled to the scene's force scale (the residual stalls at a round-off
+# floor of 2.9e-8 of the initial residual in the C-60, 1.1e-5 N, far above Exudyn's 1e-10) and
+# a friction regularisation velocity chosen by measurement on c60-on (docs/engines/exudyn.md,
+# "The C-60 in Exudyn").
+PRESETS["mechanism"] = {
+    **PRESETS["tuned"],
+    "newton_force_tolerance": 3e-6,
+    "friction_regularisation_velocity": 1e-5,
+}
+
 SOLVERS = ("GeneralizedAlpha", "TrapezoidalIndex2")
+ROTATION_COORDINATES = ("euler_parameters", "rotation_vector", "tait_bryan")
 LINEAR_SOLVERS = ("EXUdense", "EigenSparse", "EigenDense")
 RING_JOURNAL_MODELS = ("hollow_sphere", "in_plane", "facets")
 LAW_LOAD_MODES = ("explicit", "implicit")
@@ -82,6 +94,10 @@ class ExudynSettings:
         Exudyn's modified Newton (Jacobian kept between iterations; its default).
     newton_relative_tolerance, newton_absolute_tolerance : float
         Newton tolerances (Exudyn: 1e-8, 1e-10).
+    newton_force_tolerance : float or None
+        Newton's absolute tolerance as a fraction of the scene's force scale (the largest
+        applied force in the initial configuration, :func:`applied_force_scale`; Exudyn's
+        residual is a force); None: ``newton_absolute_tolerance`` as given.
     newton_max_iterations : int
         Newton iterations per step before the step counts as failed (Exudyn: 25).
     discontinuous_max_iterations : int
@@ -91,6 +107,11 @@ class ExudynSettings:
     recommended_step : bool
         Let contact connectors shorten a step so that it ends at the contact instant
         (Exudyn's ``discontinuous.useRecommendedStepSize``; needs ``adaptive_step``).
+    keep_jacobian : bool
+        With ``step_loop = 'grid'``: keep modified Newton's Jacobian from one ``SolveSteps``
+        call to the next (each call requests a new one at its start; within one call Exudyn
+        keeps it until Newton stops contracting, also after a step reduction), so the grid
+        loop computes Jacobians as one call over the horizon does.
     step_loop : {'horizon', 'grid'}
         'horizon': one ``SolveSteps`` call over the whole run, Exudyn's step control left
         alone (after a reduced step it grows the step back only after
@@ -101,6 +122,11 @@ class ExudynSettings:
         with full steps right after the instant it was localised at (bouncing ball e = 0.5,
         1st apex: +11 % default / +36 % tuned at dt 1e-3, against -0.8 % / -0.02 % with
         'horizon').
+    rotation_coordinates : {'euler_parameters', 'rotation_vector', 'tait_bryan'}
+        Rotation coordinates of the rigid-body nodes: Euler parameters (``NodeRigidBodyEP``,
+        one algebraic unit-norm constraint per body), a rotation vector
+        (``NodeRigidBodyRotVecLG``, no constraint, Lie-group update) or Tait-Bryan angles
+        (``NodeRigidBodyRxyz``, no constraint, singular at a second angle of +-90 deg).
     linear_solver : {'EXUdense', 'EigenSparse'}
     ignore_singular_jacobian : bool
         Let the linear solver pass redundant constraints (Exudyn: only with 'EigenDense',
@@ -176,11 +202,14 @@ class ExudynSettings:
     modified_newton: bool = True
     newton_relative_tolerance: float = 1e-8
     newton_absolute_tolerance: float = 1e-10
+    newton_force_tolerance: float | None = None
     newton_max_iterations: int = 25
     discontinuous_max_iterations: int = 5
     discontinuous_tolerance: float = 1.0
     recommended_step: bool = True
     step_loop: str = "grid"
+    keep_jacobian: bool = False
+    rotation_coordinates: str = "euler_parameters"
     linear_solver: str = "EXUdense"
     ignore_singular_jacobian: bool = False
     closed_loop_full_pivot: bool = True
@@ -224,11 +253,14 @@ OPTIONS = OptionTable("exudyn", (
     boolean("modified_newton"),
     number("newton_relative_tolerance", above=0.0),
     number("newton_absolute_tolerance", above=0.0),
+    number("newton_force_tolerance", above=0.0, optional=True),
     integer("newton_max_iterations", at_least=1),
     integer("discontinuous_max_iterations", at_least=1),
     number("discontinuous_tolerance", above=0.0),
     boolean("recommended_step"),
     choice("step_loop", STEP_LOOPS),
+    boolean("keep_jacobian"),
+    choice("rotation_coordinates", ROTATION_COORDINATES),
     choice("linear_solver", LINEAR_SOLVERS),
     boolean("ignore_singular_jacobian"),
     boolean("closed_loop_full_pivot"),

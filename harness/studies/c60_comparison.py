@@ -55,7 +55,7 @@ DEMO = C60Plan(
                 "pybullet[tuned]": (2e-3, 4e-3),
                 "siconos[default]": (1e-2,),
                 "siconos[projection]": (1e-2,),
-                "exudyn[tuned]": (1e-3,)},
+                "exudyn[mechanism]": (1e-3,)},
      TRIP_SCENE: {"reference[default]": (1e-3,),
                   "mujoco[tuned]": (1e-3, 4e-3)}},
     timeout=1800.0)
@@ -74,7 +74,8 @@ FULL = C60Plan(
              "siconos[nsn-ac]": (1e-3,),
              "siconos[projection]": (1e-3,),
              "exudyn[default]": (1e-3,),
-             "exudyn[tuned]": (1e-3,)} for scene in (ON_SCENE, TRIP_SCENE)},
+             "exudyn[tuned]": (1e-3,),
+             "exudyn[mechanism]": (1e-3,)} for scene in (ON_SCENE, TRIP_SCENE)},
     timeout=7200.0)
 
 PLANS = {plan.name: plan for plan in (DEMO, FULL)}
