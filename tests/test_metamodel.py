@@ -227,25 +227,26 @@ def pendulum_metamodel(samples: int = 12, **metamodel) -> dict:
     data = pendulum_campaign(samples=samples, name="pendulum-metamodel")
     data["outputs"] = [data["outputs"][1]]     # mean_x: smooth in the angle and the length
     data.update(method="metamodel", metamodel={
-        "initial": 4, "batch": 4, "candidates": ["chaos"], "max_degree": 2,
+        "initial": 6, "batch": 3, "candidates": ["chaos"], "max_degree": 1,
         "bootstrap": 10, "confirmation_runs": 0, **metamodel})
     return data
 
 
 def test_a_metamodel_campaign_stops_at_its_budget_or_its_targets(tmp_path):
     store = ResultsStore(tmp_path / "store")
-    # Q2 >= 0.999999 is out of reach of 12 runs of a degree-2 chaos: the budget ends it
+    # Q2 >= 0.999999 is out of reach of 12 runs of a linear chaos: the budget ends it
     strict = parse_campaign(pendulum_metamodel(q2=0.999999))
     state = run_metamodel_campaign(strict, store, workers=2)
     assert state["stop"] == "run budget"
-    assert [s["size"] for s in state["stages"]] == [4, 8, 12]
+    assert [s["size"] for s in state["stages"]] == [6, 9, 12]
     assert state["stages"][-1]["short"] and state["runs"] == 12
     assert len(store.keys()) == 12
-    # a loose target is met at the first stage: no run beyond the initial batch (they are
-    # the same samples, already in the store)
-    loose = parse_campaign({**pendulum_metamodel(q2=0.01), "name": "pendulum-loose"})
+    # a loose target is met at the first stage (a linear chaos of the bob's mean x, smooth in
+    # the angle and the length, validates on 9 runs well above Q2 0.5): no run beyond it
+    # (the same samples, already in the store)
+    loose = parse_campaign({**pendulum_metamodel(q2=0.5, initial=9), "name": "pendulum-loose"})
     state = run_metamodel_campaign(loose, store, workers=2)
-    assert state["stop"] == "targets met" and [s["size"] for s in state["stages"]] == [4]
+    assert state["stop"] == "targets met" and [s["size"] for s in state["stages"]] == [9]
     assert len(store.keys()) == 12
     assert load_state(store, loose)["stop"] == "targets met"
 
@@ -271,9 +272,9 @@ def _sample_keys(log: Path) -> list[str]:
 
 
 def test_a_metamodel_campaign_killed_mid_batch_resumes_with_no_run_twice(tmp_path):
-    # budget 16 in batches of 4, Q2 out of reach: every batch runs; killed after 6 runs,
-    # i.e. inside the second batch
-    campaign = write_campaign(tmp_path, pendulum_metamodel(samples=16, q2=0.999999))
+    # budget 15: 6 runs, then batches of 3, Q2 out of reach: every batch runs; killed after
+    # 7 runs, i.e. inside the second batch
+    campaign = write_campaign(tmp_path, pendulum_metamodel(samples=15, q2=0.999999))
     store_dir = tmp_path / "store"
     log = store_dir / "campaigns" / "pendulum-metamodel.jsonl"
     command = [sys.executable, "-m", "clearbench.harness.cli.main", "campaign", "run",
@@ -282,23 +283,23 @@ def test_a_metamodel_campaign_killed_mid_batch_resumes_with_no_run_twice(tmp_pat
                                stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 300
     while time.monotonic() < deadline:
-        if log.exists() and len(_sample_keys(log)) >= 6:
+        if log.exists() and len(_sample_keys(log)) >= 7:
             break
         time.sleep(0.1)
     else:
         process.kill()
-        pytest.fail("the campaign recorded 6 runs not within 300 s")
+        pytest.fail("the campaign recorded 7 runs not within 300 s")
     children = psutil.Process(process.pid).children(recursive=True)
     process.send_signal(signal.SIGKILL)
     process.wait()
     psutil.wait_procs(children, timeout=30)
     recorded = len(_sample_keys(log))
-    assert 6 <= recorded < 16
+    assert 7 <= recorded < 15
     resumed = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, timeout=600)
     assert resumed.returncode == 0, resumed.stderr
     assert "run budget" in resumed.stdout
     keys = _sample_keys(log)
-    assert len(keys) == 16 and len(set(keys)) == 16        # every run once
+    assert len(keys) == 15 and len(set(keys)) == 15        # every run once
     definition = load_campaign(campaign)
     assert set(keys) == {s.spec.key for s in plan_samples(definition)}
     # the report writes from the stored state, beside nothing (no --against)
@@ -308,5 +309,5 @@ def test_a_metamodel_campaign_killed_mid_batch_resumes_with_no_run_twice(tmp_pat
         cwd=ROOT, capture_output=True, text=True, timeout=600)
     assert report.returncode == 0, report.stderr
     markdown = (tmp_path / "out" / "pendulum-metamodel.md").read_text()
-    assert "Stopped: **run budget** after 16 runs" in markdown
+    assert "Stopped: **run budget** after 15 runs" in markdown
     assert (tmp_path / "out" / "figures" / "pendulum-metamodel_validation.png").exists()

@@ -128,9 +128,13 @@ def fit_stage(definition: CampaignDefinition, table, basis: ChaosBasis | None) -
     for index, spec in enumerate(definition.outputs):
         y = ok[spec.name].to_numpy(float)
         keep = np.isfinite(y)
-        fitted = choose_metamodel(x[keep], y[keep], basis, settings.candidates,
-                                  settings.max_degree, settings.validation, settings.folds,
-                                  seed=definition.seed + index)
+        try:
+            fitted = choose_metamodel(x[keep], y[keep], basis, settings.candidates,
+                                      settings.max_degree, settings.validation,
+                                      settings.folds, seed=definition.seed + index)
+        except ValueError as error:
+            raise CampaignError("metamodel.initial", settings.initial,
+                                f"{spec.name}: {error}; start with more runs") from None
         figures = bootstrap_estimates(fitted, basis, x[keep], y[keep], definition,
                                       spec.lower_limit, spec.upper_limit, settings.bootstrap,
                                       seed=definition.seed + 1000 * index)

@@ -190,12 +190,19 @@ def q2_score(y: np.ndarray, predictions: np.ndarray) -> float:
 
 
 def cross_validated(fit, x: np.ndarray, y: np.ndarray, parts: list[np.ndarray]) -> np.ndarray:
-    """Predictions y_hat_(-i) (n,): ``fit(x, y)`` -> predictor, refitted without each part."""
+    """Predictions y_hat_(-i) (n,): ``fit(x, y)`` -> predictor, refitted without each part;
+    NaN for a part whose fit fails (too few points for the basis: the candidate's Q2 is then
+    NaN and it is not chosen)."""
     predictions = np.empty(len(y))
     for part in parts:
         keep = np.ones(len(y), bool)
         keep[part] = False
-        predictions[part] = fit(x[keep], y[keep]).predict(x[part])
+        try:
+            predictions[part] = fit(x[keep], y[keep]).predict(x[part])
+        except (TypeError, RuntimeError, ValueError, np.linalg.LinAlgError):
+            # OpenTURNS raises its InvalidArgumentException (a null eigenvalue of a basis
+            # larger than the points) as a TypeError
+            predictions[part] = np.nan
     return predictions
 
 
@@ -234,6 +241,9 @@ def choose_metamodel(x: np.ndarray, y: np.ndarray, basis: ChaosBasis | None,
     if not tried:
         raise ValueError("no metamodel candidate to fit")
     label = max(tried, key=lambda k: -math.inf if math.isnan(tried[k][0]) else tried[k][0])
+    if math.isnan(tried[label][0]):
+        raise ValueError(f"no metamodel could be validated on {len(y)} points "
+                         f"(tried {', '.join(tried)})")
     score, predictions, degree = tried[label]
     kind = KRIGING if label == KRIGING else CHAOS
     model = fit_kriging(x, y) if kind == KRIGING else basis.fit(x, y, degree)

@@ -135,7 +135,7 @@ class BootstrapEstimates:
     st: list[Interval]
     interaction: Interval
     unexplained: float
-    replicates: int
+    replicates: int   # the bootstrap refits that succeeded
 
     def half_width(self, figure: str) -> float:
         """Largest half-width of the 95 % intervals of ``figure`` (mean, sigma, cpk, s1, st)
@@ -163,7 +163,10 @@ def bootstrap_estimates(fitted: FittedModel, basis: ChaosBasis | None, x: np.nda
     drawn = []
     for _ in range(replicates):
         rows = rng.integers(0, len(y), len(y))
-        predictor = refit(fitted, basis, x[rows], y[rows])
+        try:
+            predictor = refit(fitted, basis, x[rows], y[rows])
+        except (TypeError, RuntimeError, ValueError, np.linalg.LinAlgError):
+            continue   # a replicate with too few distinct points for the basis: not counted
         drawn.append(estimates_of(predictor, fitted.kind, points, pairs, lower, upper,
                                   residual))
 
@@ -179,4 +182,4 @@ def bootstrap_estimates(fitted: FittedModel, basis: ChaosBasis | None, x: np.nda
         s1=[interval(central.s1[i], [e.s1[i] for e in drawn]) for i in range(d)],
         st=[interval(central.st[i], [e.st[i] for e in drawn]) for i in range(d)],
         interaction=interval(central.interaction, [e.interaction for e in drawn]),
-        unexplained=central.unexplained, replicates=replicates)
+        unexplained=central.unexplained, replicates=len(drawn))
