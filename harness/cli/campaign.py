@@ -4,6 +4,10 @@
 - ``clearbench campaign report FILE|NAME [--with FILE|NAME ...]``: statistics, histograms,
   convergence and sensitivities as Markdown, HTML, JSON and CSV;
 - ``clearbench campaign status FILE|NAME``: how many samples are recorded, by status.
+
+A campaign with ``method = "metamodel"`` runs its design in batches until its metamodel's
+targets are met or its budget ends (``--given CSV`` takes design runs from a campaign's CSV),
+and its report compares it with a sampling campaign (``--against NAME``).
 """
 
 from __future__ import annotations
@@ -19,6 +23,12 @@ from clearbench.harness.cli.common import (
     add_store_option,
     open_store,
 )
+from clearbench.harness.studies.campaign.adaptive import (
+    design_table,
+    load_state,
+    run_metamodel_campaign,
+    state_path,
+)
 from clearbench.harness.studies.campaign.definition import (
     SHIPPED,
     CampaignError,
@@ -26,6 +36,7 @@ from clearbench.harness.studies.campaign.definition import (
     with_overrides,
 )
 from clearbench.harness.studies.campaign.execution import plan_samples, run_campaign
+from clearbench.harness.studies.campaign.metamodel_report import write_metamodel_report
 from clearbench.harness.studies.campaign.report import write_campaign_report
 
 #: Where reports go by default.
@@ -52,6 +63,7 @@ def register(subparsers) -> None:
     run.add_argument("--workers", type=int, default=None,
                      help="LocalCluster worker processes (default: usable cores)")
     run.add_argument("--no-progress", action="store_true", help="no progress bar")
+    _add_given_option(run)
     run.set_defaults(handler=_run)
 
     report = commands.add_parser("report", help="write the campaign's report section")
@@ -61,6 +73,10 @@ def register(subparsers) -> None:
                         "design), drawn in the convergence figures (repeatable)")
     report.add_argument("--out", default=DEFAULT_OUT, metavar="DIR",
                         help=f"output folder (default {DEFAULT_OUT})")
+    report.add_argument("--against", default=None, metavar="NAME",
+                        help="metamodel campaigns: a sampling campaign whose report is in the "
+                        "output folder, shown side by side")
+    _add_given_option(report)
     report.set_defaults(handler=_report)
 
     status = commands.add_parser("status", help="recorded samples by status")
@@ -78,6 +94,30 @@ def _add_definition_options(parser: argparse.ArgumentParser) -> None:
     add_store_option(parser)
 
 
+def _add_given_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--given", default=None, metavar="CSV",
+                        help="metamodel campaigns: design runs taken from a campaign's CSV "
+                        "(written by 'campaign report', maybe by another revision of the "
+                        "code) for the samples it holds with the same inputs")
+
+
+def _given(args: argparse.Namespace):
+    if not getattr(args, "given", None):
+        return None
+    import pandas as pd  # lazily, as the results store does
+
+    path = Path(args.given)
+    try:
+        table = pd.read_csv(path)
+    except (OSError, ValueError) as error:
+        raise UserError(f"--given {args.given}: {error}") from None
+    missing = {"sample", "status", "message"} - set(table.columns)
+    if missing:
+        raise UserError(f"--given {args.given}: not a campaign CSV (no column "
+                        f"{sorted(missing)[0]!r})")
+    return table
+
+
 def _definition(args: argparse.Namespace, text: str | None = None):
     try:
         definition = load_campaign(text or args.campaign)
@@ -92,9 +132,19 @@ def _run(args: argparse.Namespace) -> int:
         raise UserError(f"--workers {args.workers}: must be >= 1")
     workers = args.workers or max(1, len(os.sched_getaffinity(0)))
     store = open_store(args)
+    progress = not args.no_progress and sys.stderr.isatty()
+    given = _given(args)
     try:
+        if definition.method == "metamodel":
+            state = run_metamodel_campaign(definition, store, scheduler=args.scheduler,
+                                           workers=workers, progress=progress, given=given)
+            short = state["stages"][-1]["short"]
+            print(f"{definition.name}: stopped ({state['stop']}) after {state['runs']} runs "
+                  f"of {definition.samples}" + (": " + "; ".join(short) if short else "")
+                  + f"; state in {state_path(store, definition)}")
+            return 0
         outcome = run_campaign(definition, store, scheduler=args.scheduler, workers=workers,
-                               progress=not args.no_progress and sys.stderr.isatty())
+                               progress=progress)
     except CampaignError as error:
         raise UserError(f"{args.campaign}: {error}") from None
     print(f"{definition.name}: {outcome.planned} samples planned, {outcome.already} already in "
@@ -106,12 +156,29 @@ def _report(args: argparse.Namespace) -> int:
     definition = _definition(args)
     companions = tuple(_definition(args, text) for text in args.companions)
     store = open_store(args, create=False)
+    if definition.method == "metamodel":
+        return _metamodel_report(args, definition, store)
     try:
         summary = write_campaign_report(definition, store, Path(args.out), companions)
     except CampaignError as error:
         raise UserError(f"{args.campaign}: {error}") from None
     print(f"{definition.name}: {summary['statuses']}; report in {args.out}/"
           f"{definition.name}.md and .html")
+    return 0
+
+
+def _metamodel_report(args: argparse.Namespace, definition, store) -> int:
+    state = load_state(store, definition)
+    if not state.get("stages"):
+        raise UserError(f"{args.campaign}: no metamodel state in {store.directory}: run "
+                        f"'clearbench campaign run {args.campaign}' first")
+    try:
+        table = design_table(definition, store, state["stages"][-1]["size"], _given(args))
+        write_metamodel_report(definition, state, Path(args.out), args.against, table)
+    except (CampaignError, FileNotFoundError) as error:
+        raise UserError(f"{args.campaign}: {error}") from None
+    print(f"{definition.name}: {state['stop']} after {state['runs']} runs; report in "
+          f"{args.out}/{definition.name}.md and .html")
     return 0
 
 

@@ -53,14 +53,25 @@ from clearbench.harness.run.engine_choice import RunInputError
 
 #: Sampling designs. "monte-carlo": independent pseudo-random draws (the study's method);
 #: "sobol": scrambled Sobol' points (quasi-Monte Carlo, scipy.stats.qmc); "corners": every
-#: combination of the inputs' bounds (the study's worst-case analysis, Figure 14).
-DESIGNS = ("monte-carlo", "sobol", "corners")
+#: combination of the inputs' bounds (the study's worst-case analysis, Figure 14); "lhs":
+#: Latin hypercubes of one metamodel batch each (metamodel campaigns only).
+DESIGNS = ("monte-carlo", "sobol", "corners", "lhs")
+#: What a campaign computes: "sampling" (statistics of the samples themselves) or "metamodel"
+#: (a metamodel fitted on the samples, added in batches until its targets are met:
+#: :mod:`clearbench.harness.studies.campaign.metamodel`).
+METHODS = ("sampling", "metamodel")
+#: Metamodels a metamodel campaign may choose from by validation.
+METAMODELS = ("chaos", "kriging")
+#: Interval targets of a metamodel campaign: half-widths of the 95 % intervals.
+TARGETS = ("mean", "sigma", "cpk", "s1", "st")
 LAWS = ("normal", "uniform")
 STATISTICS = ("mean", "min", "max", "final")
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 _TOP_KEYS = {"name", "description", "scene", "engine", "design", "samples", "seed",
              "record_every", "time_step", "horizon", "timeout", "scene_parameters", "inputs",
-             "outputs"}
+             "outputs", "method", "metamodel"}
+_METAMODEL_KEYS = {"initial", "batch", "candidates", "validation", "folds", "q2", "targets",
+                   "bootstrap", "max_degree", "confirmation_runs"}
 _INPUT_KEYS = {"name", "parameter", "unit", "law", "mean", "sigma", "lower", "upper"}
 _OUTPUT_KEYS = {"name", "output", "statistic", "window", "unit", "lower_limit", "upper_limit",
                 "limits_source", "paper"}
@@ -123,6 +134,31 @@ class OutputSpec:
 
 
 @dataclass(frozen=True)
+class MetamodelSettings:
+    """How a metamodel campaign fits, validates and stops (the ``[metamodel]`` table).
+
+    ``initial`` design runs first, then ``batch`` more at a time until every output's Q2 is
+    at least ``q2`` and every interval target is met, or the campaign's ``samples`` (the run
+    budget) are used. ``targets`` maps ``mean`` and ``sigma`` to a 95 % half-width in units of
+    the output's sigma, ``cpk``, ``s1`` and ``st`` to an absolute half-width. Q2 is estimated
+    by ``validation``: ``"k-fold"`` with ``folds`` folds, or ``"leave-one-out"``.
+    ``confirmation_runs`` true runs check each rare-event estimate near its most probable
+    failure point.
+    """
+
+    initial: int = 64
+    batch: int = 64
+    candidates: tuple[str, ...] = METAMODELS
+    validation: str = "k-fold"
+    folds: int = 5
+    q2: float = 0.95
+    targets: Mapping = field(default_factory=dict)
+    bootstrap: int = 100
+    max_degree: int = 4
+    confirmation_runs: int = 3
+
+
+@dataclass(frozen=True)
 class CampaignDefinition:
     """A validated campaign (see the module docstring for the file format)."""
 
@@ -141,7 +177,14 @@ class CampaignDefinition:
     horizon: float | None = None
     timeout: float | None = None
     source: str = ""
+    method: str = "sampling"
+    metamodel: MetamodelSettings | None = None
     raw: Mapping = field(default_factory=dict, repr=False, compare=False)
+
+    @property
+    def block(self) -> int:
+        """Points per Latin hypercube of the ``lhs`` design (a metamodel batch)."""
+        return self.metamodel.batch if self.metamodel is not None else self.samples
 
     @property
     def dimension(self) -> int:
@@ -266,6 +309,47 @@ def _output_spec(index: int, table) -> OutputSpec:
                                                                   table.get("paper")))
 
 
+def _metamodel_settings(table, samples: int, design: str) -> MetamodelSettings:
+    where = "metamodel"
+    if not isinstance(table, Mapping):
+        raise CampaignError(where, table, "must be a table")
+    _unknown_keys(where, table, _METAMODEL_KEYS)
+    batch = _integer(f"{where}.batch", table.get("batch", min(64, samples)), 1)
+    initial = _integer(f"{where}.initial", table.get("initial", batch), 2)
+    if initial > samples:
+        raise CampaignError(f"{where}.initial", initial,
+                            f"must be <= samples ({samples}), the run budget")
+    if design == "lhs" and initial % batch:
+        raise CampaignError(f"{where}.initial", initial,
+                            f"the lhs design needs a multiple of batch ({batch})")
+    candidates = table.get("candidates", list(METAMODELS))
+    if (not isinstance(candidates, list) or not candidates
+            or any(c not in METAMODELS for c in candidates)):
+        raise CampaignError(f"{where}.candidates", candidates,
+                            f"must be a non-empty list of {', '.join(METAMODELS)}")
+    validation = table.get("validation", "k-fold")
+    if validation not in ("k-fold", "leave-one-out"):
+        raise CampaignError(f"{where}.validation", validation,
+                            "must be 'k-fold' or 'leave-one-out'")
+    folds = _integer(f"{where}.folds", table.get("folds", 5), 2)
+    q2 = _number(f"{where}.q2", table.get("q2", 0.95))
+    if not 0 < q2 < 1:
+        raise CampaignError(f"{where}.q2", q2, "must lie in (0, 1)")
+    targets = table.get("targets", {})
+    if not isinstance(targets, Mapping):
+        raise CampaignError(f"{where}.targets", targets, "must be a table")
+    _unknown_keys(f"{where}.targets", targets, set(TARGETS))
+    targets = {key: _number(f"{where}.targets.{key}", value, positive=True)
+               for key, value in targets.items()}
+    return MetamodelSettings(
+        initial=initial, batch=batch, candidates=tuple(candidates), validation=validation,
+        folds=folds, q2=q2, targets=targets,
+        bootstrap=_integer(f"{where}.bootstrap", table.get("bootstrap", 100), 10),
+        max_degree=_integer(f"{where}.max_degree", table.get("max_degree", 4), 1),
+        confirmation_runs=_integer(f"{where}.confirmation_runs",
+                                   table.get("confirmation_runs", 3), 0))
+
+
 def _unique(kind: str, names: list[str]) -> None:
     seen = set()
     for index, name in enumerate(names):
@@ -310,6 +394,22 @@ def parse_campaign(data: Mapping, source: str = "") -> CampaignDefinition:
             if other.parameter == law.parameter:
                 raise CampaignError(f"inputs[{index}].parameter", law.parameter,
                                     f"is already drawn by input {other.name!r}")
+    method = data.get("method", "sampling")
+    if method not in METHODS:
+        raise CampaignError("method", method, f"must be one of {', '.join(METHODS)}")
+    metamodel = None
+    if method == "metamodel":
+        if design not in ("sobol", "lhs", "monte-carlo"):
+            raise CampaignError("design", design,
+                                "a metamodel campaign needs sobol, lhs or monte-carlo")
+        metamodel = _metamodel_settings(data.get("metamodel", {}), samples, design)
+    elif "metamodel" in data:
+        raise CampaignError("metamodel", data["metamodel"],
+                            "only with method = \"metamodel\"")
+    elif design == "lhs":
+        raise CampaignError("design", design,
+                            "lhs only with method = \"metamodel\" (its point i depends on the "
+                            "batch size; use sobol to extend a sampling campaign)")
     if design == "corners" and samples > 2 ** len(inputs):
         raise CampaignError("samples", samples,
                             f"the corners design has 2^{len(inputs)} = {2 ** len(inputs)} points")
@@ -334,7 +434,8 @@ def parse_campaign(data: Mapping, source: str = "") -> CampaignDefinition:
         name=name, scene=scene, engine=engine, design=design, samples=samples, seed=seed,
         inputs=inputs, outputs=outputs, description=str(data.get("description", "")),
         scene_parameters=dict(scene_parameters), record_every=record_every,
-        time_step=time_step, horizon=horizon, timeout=timeout, source=source, raw=dict(data))
+        time_step=time_step, horizon=horizon, timeout=timeout, source=source, method=method,
+        metamodel=metamodel, raw=dict(data))
 
 
 #: Campaign files shipped with clearbench, by name (``clearbench campaign run c60-paper``).

@@ -10,6 +10,9 @@ A resumed or extended campaign therefore draws the same values for the samples i
   converge faster than with pseudo-random points (balance is best at powers of two).
 - ``corners``: the 2^d combinations of the inputs' bounds (the study's worst cases, Figure 14),
   corner i taking input k at its upper bound when bit k of i is set.
+- ``lhs`` (metamodel campaigns): block b = i // B of B points (B the metamodel's batch) is a
+  Latin hypercube of its own, drawn from ``(seed, b)``: each batch stratifies every input, and
+  point i depends on (seed, B, i) only, so an extended campaign keeps its earlier batches.
 
 Uniform numbers map to each input's law by its inverse distribution function: the normal law
 truncated to [lower, upper] (scipy.stats.truncnorm), or the uniform law on [lower, upper].
@@ -23,10 +26,12 @@ from scipy.stats import qmc, truncnorm
 from clearbench.harness.studies.campaign.definition import CampaignDefinition, InputLaw
 
 
-def unit_points(design: str, seed: int, dimension: int, start: int, count: int) -> np.ndarray:
+def unit_points(design: str, seed: int, dimension: int, start: int, count: int,
+                block: int = 1) -> np.ndarray:
     """Points ``start .. start + count - 1`` of a design in [0, 1]^d, shape (count, d).
 
-    For ``corners`` the points are 0 or 1 (lower or upper bound).
+    For ``corners`` the points are 0 or 1 (lower or upper bound); ``block`` is the number of
+    points of each Latin hypercube of the ``lhs`` design.
     """
     if count <= 0:
         return np.zeros((0, dimension))
@@ -38,6 +43,11 @@ def unit_points(design: str, seed: int, dimension: int, start: int, count: int) 
         if start:
             sampler.fast_forward(start)
         return sampler.random(count)
+    if design == "lhs":
+        first, last = start // block, (start + count - 1) // block
+        blocks = [qmc.LatinHypercube(dimension, seed=np.random.default_rng([seed, b]))
+                  .random(block) for b in range(first, last + 1)]
+        return np.vstack(blocks)[start - first * block:start - first * block + count]
     if design == "corners":
         indices = np.arange(start, start + count)[:, None]
         return ((indices >> np.arange(dimension)[None, :]) & 1).astype(float)
@@ -60,7 +70,8 @@ def sample_inputs(definition: CampaignDefinition, start: int = 0,
     campaign's samples."""
     if count is None:
         count = definition.samples - start
-    u = unit_points(definition.design, definition.seed, definition.dimension, start, count)
+    u = unit_points(definition.design, definition.seed, definition.dimension, start, count,
+                    definition.block)
     return np.column_stack([to_law(law, u[:, k]) for k, law in enumerate(definition.inputs)]) \
         if count > 0 else np.zeros((0, definition.dimension))
 

@@ -67,11 +67,17 @@ def plan_samples(definition: CampaignDefinition, start: int = 0,
     CampaignError
         An engine, scene, parameter or output that cannot run, naming the campaign field.
     """
+    return plan_points(definition, sample_inputs(definition, start, count), start)
+
+
+def plan_points(definition: CampaignDefinition, values: np.ndarray,
+                start: int = 0) -> list[CampaignSample]:
+    """Samples at given input values (m, d) [inputs' units], indexed from ``start`` (a
+    metamodel's confirmation runs), with their validated runs (see :func:`plan_samples`)."""
     try:
         choice = resolve_engine(definition.engine)
     except RunInputError as error:
         raise CampaignError("engine", definition.engine, error.reason) from None
-    values = sample_inputs(definition, start, count)
     samples = []
     for offset, row in enumerate(values):
         index = start + offset
@@ -224,9 +230,21 @@ def run_campaign(definition: CampaignDefinition, store: ResultsStore, *,
     progress : show a progress bar (rate and time left) on stderr.
     on_recorded : called with (sample index, record) after each sample is stored.
     """
+    return run_samples(definition, plan_samples(definition), store, scheduler=scheduler,
+                       workers=workers, progress=progress, on_recorded=on_recorded)
+
+
+def run_samples(definition: CampaignDefinition, samples: list[CampaignSample],
+                store: ResultsStore, *, scheduler: str | None = None, workers: int = 2,
+                progress: bool = False,
+                on_recorded: Callable[[int, RunRecord], None] | None = None,
+                label: Callable[[CampaignSample], int | str] | None = None
+                ) -> CampaignProgress:
+    """Run the ``samples`` of ``definition`` not yet in ``store`` on Dask (see
+    :func:`run_campaign`); ``label`` names a sample in the campaign's log (default: its
+    index)."""
     from distributed import Client, as_completed  # lazily: only campaigns need Dask
 
-    samples = plan_samples(definition)
     stored = store.keys()
     todo = [s for s in samples if s.spec.key not in stored]
     outcome = CampaignProgress(planned=len(samples), already=len(samples) - len(todo),
@@ -264,8 +282,9 @@ def run_campaign(definition: CampaignDefinition, store: ResultsStore, *,
             record = _record(store, sample, result)
             outcome.recorded += 1
             outcome.statuses[record.status] = outcome.statuses.get(record.status, 0) + 1
-            log.write(event="sample", sample=sample.index, key=record.key,
-                      status=record.status, worker_seconds=record.worker_seconds,
+            log.write(event="sample", sample=label(sample) if label else sample.index,
+                      key=record.key, status=record.status,
+                      worker_seconds=record.worker_seconds,
                       stepping_seconds=record.stepping_seconds)
             if bar is not None:
                 bar.update(1)

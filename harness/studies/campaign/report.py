@@ -252,7 +252,12 @@ def _definition_lines(summary: dict) -> list[str]:
 
 
 def render_markdown(summary: dict, figure_files: list[str]) -> str:
-    """The section as Markdown (figures referenced from ``figures/``)."""
+    """The section as Markdown (figures referenced from ``figures/``; a metamodel campaign's
+    its own)."""
+    if summary.get("method") == "metamodel":
+        from clearbench.harness.studies.campaign import metamodel_report
+
+        return metamodel_report.render_markdown(summary, figure_files)
     name = summary["definition"]["name"]
     lines = [f"## Tolerance campaign `{name}`", ""] + _definition_lines(summary) + [""]
     lines.append("| " + " | ".join(HEADER) + " |")
@@ -290,7 +295,11 @@ def _sensitivity_markdown(summary: dict) -> list[str]:
 
 def section_html(summary: dict, pngs: dict[str, bytes]) -> str:
     """The section as an HTML fragment (figures embedded), for this report and the
-    comparison report."""
+    comparison report (a metamodel campaign's its own)."""
+    if summary.get("method") == "metamodel":
+        from clearbench.harness.studies.campaign import metamodel_report
+
+        return metamodel_report.section_html(summary, pngs)
     esc = html.escape
     name = summary["definition"]["name"]
     parts = [f"<h2>Tolerance campaign <code>{esc(name)}</code></h2>"]
@@ -333,7 +342,8 @@ def load_written_sections(folder: str | Path) -> list[tuple[dict, dict[str, byte
             continue
         name = summary["definition"]["name"]
         table = folder / f"{name}.csv"
-        if table.exists():  # the statistics by this code, from the samples as recorded
+        if table.exists() and summary.get("method") != "metamodel":
+            # the statistics by this code, from the samples as recorded
             _restate_capability(summary, table)
         pngs = {figure.name: figure.read_bytes()
                 for figure in sorted((folder / "figures").glob(f"{name}_*.png"))}

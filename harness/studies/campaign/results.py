@@ -62,14 +62,15 @@ def run_outputs(store: ResultsStore, definition: CampaignDefinition, key: str,
     return {o.name: collect(o, trajectory.times, series[o.output]) for o in definition.outputs}
 
 
-def campaign_table(definition: CampaignDefinition, store: ResultsStore):
-    """One row per planned sample: sample, key, status, message, worker_seconds,
+def campaign_table(definition: CampaignDefinition, store: ResultsStore, samples=None):
+    """One row per planned sample (or per sample of ``samples``, a list of
+    :class:`CampaignSample`): sample, key, status, message, worker_seconds,
     stepping_seconds, the inputs and the outputs by name (a pandas DataFrame). Samples not
     recorded yet have status "pending"; outputs of runs that did not end ok are kept as
     computed (the statistics use the ok runs and count the others)."""
     import pandas as pd  # lazily, as the results store does
 
-    samples = plan_samples(definition)
+    samples = plan_samples(definition) if samples is None else samples
     path, digest, cached, whole = _output_cache(store, definition)
     rows = []
     changed = False
