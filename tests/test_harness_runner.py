@@ -91,7 +91,8 @@ def test_energy_growth_is_a_diverged_verdict_when_metrics_are_available(tmp_path
     ({"time_step": 2.0, "horizon": 1.0}, "time_step"),
     ({"record_every": 0}, "record_every"),
     ({"timeout": 0}, "timeout"),
-    ({"options": {"no_such_option": 1}}, "options"),
+    ({"options": {"no_such_option": 1}}, "fake option no_such_option"),
+    ({"options": {"sleep": -1.0}}, "fake option sleep"),
     ({"scene_parameters": {"no_such_parameter": 1}}, "scene parameter 'no_such_parameter'"),
     ({"scene_parameters": {"radial_clearance": -1.0}}, "scene"),
 ])
