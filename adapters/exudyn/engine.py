@@ -140,6 +140,7 @@ def _metadata(scene: Scene, internal: Scene, config: ExudynSettings, built, runn
         "force_scale": runner.force_scale_value,
         "newton_absolute_tolerance": runner.newton_absolute_tolerance,
         "solver_steps": runner.solver_steps,
+        "solver_statistics": runner.solver_statistics(),
         "nominal_steps": runner.steps,
         "reduced_steps": max(0, runner.solver_steps - int(round(last_time / built.time_step))),
         "discontinuous_iteration_failures": runner.discontinuous_failures_total,
