@@ -8,7 +8,9 @@ Presets (``exudyn[<preset>]``, see :mod:`.settings`):
   k = m (2 pi / (10 dt))^2 (Exudyn's own default stiffness is 0: no contact);
 - ``tuned``: v_reg = 1e-7 m/s, minimum impact velocity 0.01 m/s (damped resting contacts),
   contact period 4 steps of the scene's comfortable step (one contact model for every dt),
-  e = 0 pairs at e = 0.05 (no pulling contact force).
+  e = 0 pairs at e = 0.05 (no pulling contact force);
+- ``mechanism``: ``tuned`` with Newton's absolute tolerance 3e-6 of the scene's force scale
+  and v_reg = 1e-5 m/s (the C-60: Newton's residual floor, friction direction flips).
 
 ``RunSettings.options`` override any field of :class:`~.settings.ExudynSettings` (checked
 before the run: ValueError naming the option and value).
@@ -140,6 +142,7 @@ def _metadata(scene: Scene, internal: Scene, config: ExudynSettings, built, runn
         "force_scale": runner.force_scale_value,
         "newton_absolute_tolerance": runner.newton_absolute_tolerance,
         "solver_steps": runner.solver_steps,
+        "solver_statistics": runner.solver_statistics(),
         "nominal_steps": runner.steps,
         "reduced_steps": max(0, runner.solver_steps - int(round(last_time / built.time_step))),
         "discontinuous_iteration_failures": runner.discontinuous_failures_total,

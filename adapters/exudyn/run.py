@@ -50,6 +50,10 @@ from clearbench.scenarios.scene import Scene
 
 logger = logging.getLogger(__name__)
 
+#: Exudyn's timers kept in the metadata (``solver.timer``; wall seconds).
+TIMERS = ("jacobianODE2", "jacobianAE", "ODE2RHS", "AERHS", "massMatrix", "factorization",
+          "postNewton", "python", "reactionForces")
+
 
 def simulation_settings(settings: ExudynSettings, time_step: float, steps: int,
                         closed_loop: bool = False):
@@ -85,6 +89,9 @@ def simulation_settings(settings: ExudynSettings, time_step: float, steps: int,
     s.solution.sensors.active = False
     s.solution.restart.write = False
     s.show.computationTime = False
+    # Exudyn's timers (Jacobians, residuals, Python user functions; read into the metadata)
+    # run only with this flag; it also prints them at the end, into the captured stdout.
+    s.displayComputationTime = True
     s.show.statistics = False
     return s
 
@@ -394,6 +401,19 @@ class Runner:
                 self.store(mbs.systemData.GetTime(), self.state())
             logger.info("%s: stopped: %s", self.scene.name, message)
         return status, message
+
+    def solver_statistics(self) -> dict:
+        """Exudyn's counters and timers of the run [s, wall]: Newton iterations, Jacobians,
+        discontinuous iterations, and the time in Jacobians, residuals and Python user
+        functions (``solver.timer``)."""
+        solver = self._solver
+        if solver is None:
+            return {}
+        timer = solver.timer
+        return {"newton_iterations": int(solver.it.newtonStepsCount),
+                "jacobians": int(solver.it.newtonJacobiCount),
+                "discontinuous_iterations": int(solver.it.discontinuousIterationsCount),
+                "timers": {name: float(getattr(timer, name)) for name in TIMERS}}
 
     def _read_failure(self, solver, simulation) -> None:
         """The failure's reason from the solver's flags (:mod:`.failure`; Exudyn's own error
