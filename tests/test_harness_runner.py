@@ -214,8 +214,11 @@ def test_kill_9_of_a_sweep_then_rerun_gives_every_run_exactly_once(tmp_path):
     sweep.send_signal(signal.SIGKILL)
     sweep.wait()
     assert workers, "the sweep ran its runs in worker processes"
-    # Workers die with their parent (PR_SET_PDEATHSIG): none is left running.
-    deadline = time.monotonic() + 10
+    # Workers die with their parent (PR_SET_PDEATHSIG): none is left running. A worker killed
+    # while still importing (spawn) sets PR_SET_PDEATHSIG only once its import ends, then sees
+    # its parent gone (getppid) and exits: its import took up to 25 s at load average 5-9 on
+    # 2 cores, so 90 s bounds a loaded machine while an orphan that never exits still fails.
+    deadline = time.monotonic() + 90
     while time.monotonic() < deadline and any(_alive(p) for p in workers):
         time.sleep(0.05)
     assert not any(_alive(p) for p in workers)
