@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from clearbench.harness.measure.figures import ENERGY_BALANCE
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.units import UnitSystem
 from clearbench.scenarios.validation import ACCELERATION, FORCE, LENGTH, TIME, VELOCITY
@@ -85,7 +86,8 @@ EXPECTATION_FIGURES: dict[str, dict[str, FigureUnit]] = {
                       "acceleration_relative_error": _of("the expected acceleration"),
                       "displacement_max_error": L},
     "sliding_stop": {"stop_distance": L, "expected_stop_distance": L, "stop_distance_error": L,
-                     "stop_time": T, "stop_time_error": T},
+                     "stop_time": T, "stop_time_error": T, "slide_after_stop": L,
+                     "final_speed": V},
     "rolling_transition": {"onset_time": T, "onset_time_error": T, "final_speed": V,
                            "final_speed_relative_error": _of("the expected final speed")},
     "pendulum": {"energy_drift": _of("m g d"), "expected_period": T, "period": T,
@@ -101,6 +103,12 @@ EXPECTATION_FIGURES: dict[str, dict[str, FigureUnit]] = {
     "rocking_ratio": {"expected_ratio": PURE, "impacts": COUNT, "ratio_first_impact": PURE,
                       "ratio_relative_error": _of("the expected ratio")},
     "energy_non_increasing": {"energy_growth": E, "energy_growth_relative": _of("energy_scale")},
+    "energy_balance": {"energy_growth": E, "energy_growth_relative": _of("energy_scale")},
+    "rolling_incline": {"distance": L, "expected_distance": L,
+                        "distance_relative_error": _of("the expected distance"),
+                        "expected_acceleration": A, "expected_final_speed": V,
+                        "slip_speed_max": V},
+    "output_value": {"time": T},
     "energy_conserved": {"energy_drift": E, "energy_drift_relative": _of("energy_scale")},
     "no_penetration": {"penetration_max": L},
 }
@@ -143,13 +151,31 @@ def figure_unit(name: str, scene: Scene | None = None,
         if output is not None:
             return RAD if output.kind == "body_angle" else FigureUnit(tuple(output.dimension))
         return None
-    kinds = dict(expectation_kinds or {})
+    kinds = {ENERGY_BALANCE: ENERGY_BALANCE, **dict(expectation_kinds or {})}
     if scene is not None:
         kinds.update({e.name: e.kind for e in scene.expectations})
+        output_unit = _output_value_unit(scene, head, figure)
+        if output_unit is not None:
+            return output_unit
     table = EXPECTATION_FIGURES.get(kinds.get(head, ""), {})
     if figure.startswith("apex_") and figure.endswith("_relative_error"):
         figure = "apex_max_relative_error"  # apex_K_relative_error: the same ratio per bounce
     return table.get(figure)
+
+
+def _output_value_unit(scene: Scene, expectation: str, figure: str) -> FigureUnit | None:
+    """The unit of an ``output_value`` expectation's value figures: its output's."""
+    exp = next((e for e in scene.expectations if e.name == expectation), None)
+    if exp is None or exp.kind != "output_value" or figure not in OUTPUT_VALUE_FIGURES:
+        return None
+    output = next((o for o in scene.outputs if o.name == exp.output), None)
+    if output is None:
+        return None
+    return RAD if output.kind == "body_angle" else FigureUnit(tuple(output.dimension))
+
+
+#: Figures of an ``output_value`` expectation in the unit of its output.
+OUTPUT_VALUE_FIGURES = ("value", "expected", "deviation", "tolerance")
 
 
 def unit_text(name: str, scene: Scene | None, expectation_kinds: dict[str, str] | None = None,
