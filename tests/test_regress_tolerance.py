@@ -207,3 +207,23 @@ def test_a_numba_code_generation_variable_gets_its_own_cache_directory(monkeypat
     assert len(caches) == 3 and all(c.startswith(str(plain)) for c in caches)
     assert "NUMBA_CACHE_DIR" not in worker_environment({"OPENBLAS_CORETYPE": "Prescott"})
     assert worker_environment(None) == {}
+
+
+def test_the_warm_up_runs_each_reference_scene_for_two_steps_with_a_long_limit():
+    from clearbench.harness.studies.regress.suite import (
+        DEFAULT_SUITE,
+        WARM_UP_TIMEOUT,
+        warm_up_specs,
+    )
+
+    entries = {e["id"]: e for e in DEFAULT_SUITE}
+    specs = warm_up_specs(entries)
+    assert sorted(s.scene.name for s in specs) == sorted(
+        ["bouncing-ball-e0.5", "incline-stick", "sliding-box", "pendulum",
+         "clearance-pendulum", "c60-on"])
+    assert all(s.engine.name == "reference" for s in specs)
+    for spec in specs:
+        # Two steps compile every kernel a step uses; the limit covers a compilation from an
+        # empty cache on a loaded machine.
+        assert spec.horizon == pytest.approx(2 * spec.time_step)
+        assert spec.timeout == WARM_UP_TIMEOUT

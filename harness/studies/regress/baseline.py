@@ -75,7 +75,8 @@ def _stored(result: dict) -> dict:
               "expectations_passed": result["expectations_passed"],
               "engine_version": result.get("engine_version", ""),
               "metrics": {k: _plain(v) for k, v in sorted(result["metrics"].items())}}
-    for key in ("statuses_seen", "expectations_seen", "perturbations", "checks"):
+    for key in ("statuses_seen", "expectations_seen", "perturbations",
+                "perturbation_failures", "checks"):
         if key in result:
             stored[key] = result[key]
     return stored
