@@ -247,7 +247,9 @@ def _rare_markdown(summary: dict) -> list[str]:
     for event in events:
         for side in event["sides"]:
             runs = side.get("confirmation", [])
-            if side["origin_fails"]:
+            if side.get("note"):
+                check = f"none: {side['note']}"
+            elif side["origin_fails"]:
                 check = "none: the median design is outside this limit (no rare event)"
             elif not runs:
                 check = "none"
