@@ -80,7 +80,7 @@ def summarise(definition: CampaignDefinition, state: dict, against: dict | None)
                         "outputs": [{k: o[k] for k in ("name", "kind", "degree", "q2", "mean",
                                                        "sigma", "s1", "st")}
                                     for o in s["outputs"]]} for s in state["stages"]],
-            "outputs": outputs, "rare_events": state.get("rare_events", []),
+            "outputs": outputs, "rare_events": state.get("rare_events"),
             "against": (against or {}).get("definition", {}).get("name")}
 
 
@@ -236,6 +236,9 @@ def render_markdown(summary: dict, figure_files: list[str]) -> str:
 
 def _rare_markdown(summary: dict) -> list[str]:
     events = summary["rare_events"]
+    if events is None:
+        return ["Failure probabilities: pending (the campaign stopped before its rare-event "
+                "estimates and confirmation runs; run it again to complete them)."]
     if not events:
         return ["No output has specification limits: no failure probability."]
     lines = ["Failure probability outside the limits, on the metamodel with its unexplained "
