@@ -36,7 +36,10 @@ from clearbench.harness.studies.campaign.metamodel import (
     input_distribution,
     q2_score,
 )
-from clearbench.harness.studies.campaign.metamodel_estimates import bootstrap_estimates
+from clearbench.harness.studies.campaign.metamodel_estimates import (
+    bootstrap_estimates,
+    pick_freeze,
+)
 from clearbench.harness.studies.campaign.rare_events import failure_probability
 from tests.test_campaign import (
     campaign_command,
@@ -186,6 +189,18 @@ def test_ishigami_indices_lie_within_their_bootstrap_intervals():
     # interactions: only x1-x3, V13 / V = 0.2437 = 1 - S1_1 - S1_2
     assert figures.interaction.low - 1e-3 <= 1 - ISHIGAMI_S1.sum() \
         <= figures.interaction.high + 1e-3
+
+
+def test_pick_freeze_indices_do_not_depend_on_the_outputs_offset():
+    # y = offset + x1 + 0.5 x2 on U(0, 1)^3: S1 = ST = (0.8, 0.2, 0); an offset 1000 times the
+    # spread (an FC at 10.7 mm with a sigma of 0.07 mm is 150 times) must change nothing
+    rng = np.random.default_rng(0)
+    a, b = rng.random((8192, 3)), rng.random((8192, 3))
+    for offset in (0.0, 300.0):
+        first, total = pick_freeze(lambda x, c=offset: c + x[:, 0] + 0.5 * x[:, 1], a, b)
+        # 8192 pairs: the estimators' standard errors are about 0.01
+        assert first == pytest.approx([0.8, 0.2, 0.0], abs=0.04)
+        assert total == pytest.approx([0.8, 0.2, 0.0], abs=0.04)
 
 
 @pytest.mark.slow
