@@ -88,7 +88,11 @@ def side_probability(fitted: FittedModel, distribution, side: str, limit: float,
     solver.setMaximumConstraintError(1e-8 * max(abs(limit), 1.0))
     solver.setCheckStatus(False)   # judged below by the design point's own value
     form = ot.FORM(solver, event, extended.getMean())
-    form.run()
+    try:
+        form.run()
+    except RuntimeError as error:   # OpenTURNS: the design point is not on the limit
+        return _monte_carlo(event, side, limit, seed,
+                            f"FORM found no point on the limit ({str(error)[:120]})")
     result = form.getResult()
     point = np.asarray(result.getPhysicalSpaceDesignPoint(), float)
     value = float(function(list(point))[0])
