@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import tomli_w
 from scipy import stats
 
 from clearbench.harness.run.store import ResultsStore
@@ -46,7 +47,6 @@ from tests.test_campaign import (
     kill_after,
     pendulum_campaign,
     recorded_keys,
-    write_campaign,
 )
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -286,7 +286,8 @@ def test_given_runs_must_have_the_designs_inputs(tmp_path):
 def test_a_metamodel_campaign_killed_mid_batch_resumes_with_no_run_twice(tmp_path):
     # budget 15: 6 runs, then batches of 3, Q2 out of reach: every batch runs; killed after
     # 7 runs, i.e. inside the second batch
-    campaign = write_campaign(tmp_path, pendulum_metamodel(samples=15, q2=0.999999))
+    campaign = tmp_path / "pendulum-metamodel.toml"
+    campaign.write_text(tomli_w.dumps(pendulum_metamodel(samples=15, q2=0.999999)))
     store_dir = tmp_path / "store"
     log = store_dir / "campaigns" / "pendulum-metamodel.jsonl"
     command = campaign_command(campaign, store_dir)
