@@ -148,8 +148,10 @@ def convergence_figure(name: str, unit: str, stages: list[dict], against: dict |
     for axis, key in ((top, "mean"), (bottom, "sigma")):
         entries = [next(o for o in s["outputs"] if o["name"] == name)[key] for s in stages]
         centre = np.array([e["value"] for e in entries])
-        axis.errorbar(runs, centre, yerr=[centre - [e["low"] for e in entries],
-                                          [e["high"] for e in entries] - centre],
+        # a point estimate may lie outside its percentile interval (few refits): no negative bar
+        below = np.maximum(centre - [e["low"] for e in entries], 0.0)
+        above = np.maximum([e["high"] for e in entries] - centre, 0.0)
+        axis.errorbar(runs, centre, yerr=[below, above],
                       marker="o", capsize=3, color="#1b9e77", label="metamodel")
         if against:
             band = against[key]
