@@ -323,36 +323,48 @@ def test_the_report_lists_a_study_before_the_companions_named_after_it(tmp_path)
     assert names == ["c60-paper", "c60-paper-mc", "c60-paper-mc-identified"]
 
 
-def _recorded_keys(log: Path) -> list[str]:
+def recorded_keys(log: Path) -> list[str]:
+    """Run keys of the samples a campaign's log records, in order."""
     return [json.loads(line)["key"] for line in log.read_text().splitlines()
             if json.loads(line).get("event") == "sample"]
+
+
+def campaign_command(campaign: Path, store_dir: Path) -> list[str]:
+    return [sys.executable, "-m", "clearbench.harness.cli.main", "campaign", "run",
+            str(campaign), "--store", str(store_dir), "--workers", "2", "--no-progress"]
+
+
+def kill_after(command: list[str], log: Path, count: int, within: float = 300) -> int:
+    """Start the campaign ``command``, SIGKILL it once its ``log`` records ``count`` samples
+    (failing after ``within`` seconds), check that its cluster died with it; returns the
+    samples recorded."""
+    process = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + within
+    while time.monotonic() < deadline:
+        if log.exists() and len(recorded_keys(log)) >= count:
+            break
+        time.sleep(0.1)
+    else:
+        process.kill()
+        pytest.fail(f"the campaign recorded {count} samples not within {within:g} s")
+    children = psutil.Process(process.pid).children(recursive=True)
+    process.send_signal(signal.SIGKILL)
+    process.wait()
+    psutil.wait_procs(children, timeout=30)   # the cluster dies with its client
+    assert not [c for c in children if c.is_running() and c.status() != "zombie"]
+    return len(recorded_keys(log))
 
 
 def test_a_campaign_killed_with_sigkill_resumes_with_no_sample_lost_or_twice(tmp_path):
     campaign = write_campaign(tmp_path, pendulum_campaign(samples=8))
     store_dir = tmp_path / "store"
     log = store_dir / "campaigns" / "pendulum-test.jsonl"
-    command = [sys.executable, "-m", "clearbench.harness.cli.main", "campaign", "run",
-               str(campaign), "--store", str(store_dir), "--workers", "2", "--no-progress"]
-    process = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.DEVNULL,
-                               stderr=subprocess.DEVNULL)
-    deadline = time.monotonic() + 300
-    while time.monotonic() < deadline:
-        if log.exists() and len(_recorded_keys(log)) >= 2:
-            break
-        time.sleep(0.2)
-    else:
-        process.kill()
-        pytest.fail("the campaign recorded nothing within 300 s")
-    children = psutil.Process(process.pid).children(recursive=True)
-    process.send_signal(signal.SIGKILL)
-    process.wait()
-    psutil.wait_procs(children, timeout=30)   # the cluster dies with its client
-    assert not [c for c in children if c.is_running() and c.status() != "zombie"]
-    assert len(_recorded_keys(log)) >= 2
+    command = campaign_command(campaign, store_dir)
+    assert kill_after(command, log, 2) >= 2
     resumed = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, timeout=600)
     assert resumed.returncode == 0, resumed.stderr
-    keys = _recorded_keys(log)
+    keys = recorded_keys(log)
     assert len(keys) == 8 and len(set(keys)) == 8        # every sample once
     definition = load_campaign(campaign)
     expected = {sample.spec.key for sample in plan_samples(definition)}

@@ -5,17 +5,14 @@ made twice."""
 
 from __future__ import annotations
 
-import json
 import math
-import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
-import psutil
 import pytest
+import tomli_w
 from scipy import stats
 
 from clearbench.harness.run.store import ResultsStore
@@ -40,9 +37,17 @@ from clearbench.harness.studies.campaign.metamodel import (
     input_distribution,
     q2_score,
 )
-from clearbench.harness.studies.campaign.metamodel_estimates import bootstrap_estimates
+from clearbench.harness.studies.campaign.metamodel_estimates import (
+    bootstrap_estimates,
+    pick_freeze,
+)
 from clearbench.harness.studies.campaign.rare_events import failure_probability
-from tests.test_campaign import pendulum_campaign, write_campaign
+from tests.test_campaign import (
+    campaign_command,
+    kill_after,
+    pendulum_campaign,
+    recorded_keys,
+)
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -186,6 +191,18 @@ def test_ishigami_indices_lie_within_their_bootstrap_intervals():
         <= figures.interaction.high + 1e-3
 
 
+def test_pick_freeze_indices_do_not_depend_on_the_outputs_offset():
+    # y = offset + x1 + 0.5 x2 on U(0, 1)^3: S1 = ST = (0.8, 0.2, 0); an offset 1000 times the
+    # spread (an FC at 10.7 mm with a sigma of 0.07 mm is 150 times) must change nothing
+    rng = np.random.default_rng(0)
+    a, b = rng.random((8192, 3)), rng.random((8192, 3))
+    for offset in (0.0, 300.0):
+        first, total = pick_freeze(lambda x, c=offset: c + x[:, 0] + 0.5 * x[:, 1], a, b)
+        # 8192 pairs: the estimators' standard errors are about 0.01
+        assert first == pytest.approx([0.8, 0.2, 0.0], abs=0.04)
+        assert total == pytest.approx([0.8, 0.2, 0.0], abs=0.04)
+
+
 @pytest.mark.slow
 def test_the_degree_search_chooses_a_chaos_for_ishigami():
     inputs = [uniform(n, -math.pi, math.pi) for n in ("x1", "x2", "x3")]
@@ -266,39 +283,20 @@ def test_given_runs_must_have_the_designs_inputs(tmp_path):
     assert "sample 2" in error.value.field
 
 
-def _sample_keys(log: Path) -> list[str]:
-    return [json.loads(line)["key"] for line in log.read_text().splitlines()
-            if json.loads(line).get("event") == "sample"]
-
-
 def test_a_metamodel_campaign_killed_mid_batch_resumes_with_no_run_twice(tmp_path):
     # budget 15: 6 runs, then batches of 3, Q2 out of reach: every batch runs; killed after
     # 7 runs, i.e. inside the second batch
-    campaign = write_campaign(tmp_path, pendulum_metamodel(samples=15, q2=0.999999))
+    campaign = tmp_path / "pendulum-metamodel.toml"
+    campaign.write_text(tomli_w.dumps(pendulum_metamodel(samples=15, q2=0.999999)))
     store_dir = tmp_path / "store"
     log = store_dir / "campaigns" / "pendulum-metamodel.jsonl"
-    command = [sys.executable, "-m", "clearbench.harness.cli.main", "campaign", "run",
-               str(campaign), "--store", str(store_dir), "--workers", "2", "--no-progress"]
-    process = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.DEVNULL,
-                               stderr=subprocess.DEVNULL)
-    deadline = time.monotonic() + 300
-    while time.monotonic() < deadline:
-        if log.exists() and len(_sample_keys(log)) >= 7:
-            break
-        time.sleep(0.1)
-    else:
-        process.kill()
-        pytest.fail("the campaign recorded 7 runs not within 300 s")
-    children = psutil.Process(process.pid).children(recursive=True)
-    process.send_signal(signal.SIGKILL)
-    process.wait()
-    psutil.wait_procs(children, timeout=30)
-    recorded = len(_sample_keys(log))
-    assert 7 <= recorded < 15
+    command = campaign_command(campaign, store_dir)
+    # (the first stage's fits come before the 7th run: a longer wait than a sampling campaign's)
+    assert 7 <= kill_after(command, log, 7, within=900) < 15
     resumed = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, timeout=600)
     assert resumed.returncode == 0, resumed.stderr
     assert "run budget" in resumed.stdout
-    keys = _sample_keys(log)
+    keys = recorded_keys(log)
     assert len(keys) == 15 and len(set(keys)) == 15        # every run once
     definition = load_campaign(campaign)
     assert set(keys) == {s.spec.key for s in plan_samples(definition)}

@@ -221,6 +221,8 @@ def run_metamodel_campaign(definition: CampaignDefinition, store: ResultsStore, 
     final = stages[-1]
     state.update(stages=[{k: v for k, v in s.items()} for s in stages], stop=reason,
                  runs=final["runs"], budget=definition.samples)
+    state.pop("rare_events", None)
+    _save_state(store, definition, state)   # the stages, before the confirmation runs
     state["rare_events"] = _rare_events(definition, store, table, final, distribution, basis,
                                         scheduler, workers, progress)
     _save_state(store, definition, state)

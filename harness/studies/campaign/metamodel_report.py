@@ -80,7 +80,7 @@ def summarise(definition: CampaignDefinition, state: dict, against: dict | None)
                         "outputs": [{k: o[k] for k in ("name", "kind", "degree", "q2", "mean",
                                                        "sigma", "s1", "st")}
                                     for o in s["outputs"]]} for s in state["stages"]],
-            "outputs": outputs, "rare_events": state.get("rare_events", []),
+            "outputs": outputs, "rare_events": state.get("rare_events"),
             "against": (against or {}).get("definition", {}).get("name")}
 
 
@@ -148,8 +148,10 @@ def convergence_figure(name: str, unit: str, stages: list[dict], against: dict |
     for axis, key in ((top, "mean"), (bottom, "sigma")):
         entries = [next(o for o in s["outputs"] if o["name"] == name)[key] for s in stages]
         centre = np.array([e["value"] for e in entries])
-        axis.errorbar(runs, centre, yerr=[centre - [e["low"] for e in entries],
-                                          [e["high"] for e in entries] - centre],
+        # a point estimate may lie outside its percentile interval (few refits): no negative bar
+        below = np.maximum(centre - [e["low"] for e in entries], 0.0)
+        above = np.maximum([e["high"] for e in entries] - centre, 0.0)
+        axis.errorbar(runs, centre, yerr=[below, above],
                       marker="o", capsize=3, color="#1b9e77", label="metamodel")
         if against:
             band = against[key]
@@ -236,6 +238,9 @@ def render_markdown(summary: dict, figure_files: list[str]) -> str:
 
 def _rare_markdown(summary: dict) -> list[str]:
     events = summary["rare_events"]
+    if events is None:
+        return ["Failure probabilities: pending (the campaign stopped before its rare-event "
+                "estimates and confirmation runs; run it again to complete them)."]
     if not events:
         return ["No output has specification limits: no failure probability."]
     lines = ["Failure probability outside the limits, on the metamodel with its unexplained "
@@ -247,7 +252,9 @@ def _rare_markdown(summary: dict) -> list[str]:
     for event in events:
         for side in event["sides"]:
             runs = side.get("confirmation", [])
-            if side["origin_fails"]:
+            if side.get("note"):
+                check = f"none: {side['note']}"
+            elif side["origin_fails"]:
                 check = "none: the median design is outside this limit (no rare event)"
             elif not runs:
                 check = "none"

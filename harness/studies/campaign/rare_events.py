@@ -53,6 +53,7 @@ class LimitEstimate:
     draws: int
     design_point: list[float] = field(default_factory=list)
     standard_point: list[float] = field(default_factory=list)
+    note: str = ""
 
 
 def _limit_state(fitted: FittedModel, residual_sigma: float, dimension: int):
@@ -85,9 +86,22 @@ def side_probability(fitted: FittedModel, distribution, side: str, limit: float,
     solver = ot.Cobyla()
     solver.setMaximumCallsNumber(4000)
     solver.setMaximumConstraintError(1e-8 * max(abs(limit), 1.0))
+    solver.setCheckStatus(False)   # judged below by the design point's own value
     form = ot.FORM(solver, event, extended.getMean())
-    form.run()
+    try:
+        form.run()
+    except RuntimeError as error:   # OpenTURNS: the design point is not on the limit
+        return _monte_carlo(event, side, limit, seed,
+                            f"FORM found no point on the limit ({str(error)[:120]})")
     result = form.getResult()
+    point = np.asarray(result.getPhysicalSpaceDesignPoint(), float)
+    value = float(function(list(point))[0])
+    spread = max(abs(limit), 1.0)
+    if not abs(value - limit) <= 1e-6 * spread:
+        # no design point on the limit (an event the inputs and the unexplained part cannot
+        # reach, or the optimiser out of calls): plain Monte Carlo on the metamodel
+        return _monte_carlo(event, side, limit, seed,
+                            f"FORM found no point on the limit (g = {value:.6g})")
     beta = float(result.getHasoferReliabilityIndex())
     origin_fails = bool(result.getIsStandardPointOriginInFailureSpace())
     probability = float(result.getEventProbability())
@@ -106,6 +120,25 @@ def side_probability(fitted: FittedModel, distribution, side: str, limit: float,
         draws=int(simulated.getOuterSampling() * simulated.getBlockSize()),
         design_point=list(np.asarray(result.getPhysicalSpaceDesignPoint(), float)[:d]),
         standard_point=list(np.asarray(result.getStandardSpaceDesignPoint(), float)))
+
+
+def _monte_carlo(event, side: str, limit: float, seed: int, note: str) -> LimitEstimate:
+    """Plain Monte Carlo on the metamodel (``MAXIMUM_DRAWS`` draws at most, to the target
+    CV), where FORM has no design point."""
+    ot = _ot()
+    ot.RandomGenerator.SetSeed(seed)
+    algorithm = ot.ProbabilitySimulationAlgorithm(event, ot.MonteCarloExperiment())
+    algorithm.setBlockSize(BLOCK)
+    algorithm.setMaximumOuterSampling(MAXIMUM_DRAWS // BLOCK)
+    algorithm.setMaximumCoefficientOfVariation(TARGET_CV)
+    algorithm.run()
+    simulated = algorithm.getResult()
+    estimate = float(simulated.getProbabilityEstimate())
+    cv = float(simulated.getCoefficientOfVariation()) if estimate > 0 else math.nan
+    return LimitEstimate(side=side, limit=float(limit), form=math.nan, beta=math.nan,
+                         origin_fails=estimate > 0.5, importance=estimate, importance_cv=cv,
+                         draws=int(simulated.getOuterSampling() * simulated.getBlockSize()),
+                         note=note + "; plain Monte Carlo on the metamodel")
 
 
 def confirmation_points(distribution, estimate: LimitEstimate, count: int,
@@ -140,6 +173,7 @@ def failure_probability(fitted: FittedModel, distribution, lower: float | None,
                    if s.importance > 0 and math.isfinite(s.importance_cv))
     cv = math.sqrt(variance) / total if total > 0 else math.nan
     half = 1.96 * math.sqrt(variance)
-    return {"sides": sides, "ppm_form": 1e6 * sum(s.form for s in sides),
+    return {"sides": sides, "ppm_form": 1e6 * sum(s.form for s in sides
+                                                  if math.isfinite(s.form)),
             "ppm_importance": 1e6 * total, "importance_cv": cv,
             "ppm_importance_interval": [1e6 * max(total - half, 0.0), 1e6 * (total + half)]}
