@@ -16,15 +16,8 @@ import numpy as np
 
 from clearbench.harness.report.figures import _png, _pyplot
 from clearbench.harness.studies.campaign.definition import CampaignDefinition
+from clearbench.harness.studies.campaign.report import _fmt
 from clearbench.harness.studies.campaign.results import definition_summary
-
-
-def _fmt(value, digits: int = 4) -> str:
-    if value is None:
-        return "-"
-    if isinstance(value, float) and not math.isfinite(value):
-        return "nan"
-    return f"{value:.{digits}g}"
 
 
 def _ci(interval, digits: int = 4) -> str:
