@@ -16,7 +16,7 @@ import numpy as np
 
 from clearbench.harness.report.figures import _png, _pyplot
 from clearbench.harness.studies.campaign.definition import CampaignDefinition
-from clearbench.harness.studies.campaign.report import _fmt
+from clearbench.harness.studies.campaign.formatting import format_number as _fmt
 from clearbench.harness.studies.campaign.results import definition_summary
 
 

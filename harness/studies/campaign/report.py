@@ -20,6 +20,7 @@ from scipy import stats
 from clearbench.harness.report.figures import _png, _pyplot
 from clearbench.harness.run.store import ResultsStore
 from clearbench.harness.studies.campaign.definition import CampaignDefinition
+from clearbench.harness.studies.campaign.formatting import format_number as _fmt
 from clearbench.harness.studies.campaign.results import (
     campaign_table,
     definition_summary,
@@ -39,14 +40,6 @@ PAPER_CPUS = 160
 PAPER_RUNS = 30_850
 #: Half-width of Cpk's 95 % interval the report sizes the campaign for.
 CPK_HALF_WIDTH = 0.1
-
-
-def _fmt(value, digits: int = 4) -> str:
-    if value is None:
-        return "-"
-    if isinstance(value, float) and not math.isfinite(value):
-        return "nan"
-    return f"{value:.{digits}g}"
 
 
 def _interval(value, digits: int = 4) -> str:
