@@ -104,6 +104,14 @@ def side_probability(fitted: FittedModel, distribution, side: str, limit: float,
                             f"FORM found no point on the limit (g = {value:.6g})")
     beta = float(result.getHasoferReliabilityIndex())
     origin_fails = bool(result.getIsStandardPointOriginInFailureSpace())
+    if origin_fails:
+        # the median inputs already fail: the event is not rare, FORM's tangent plane says
+        # little about a probability near or above one half, and draws centred on u* miss
+        # the bulk of the failure domain around the origin; plain Monte Carlo is accurate
+        # at this probability with few draws
+        return _monte_carlo(event, side, limit, seed,
+                            f"the median inputs fail (beta {beta:.3g} from the failure side)",
+                            form=float(result.getEventProbability()), beta=beta)
     probability = float(result.getEventProbability())
     ot.RandomGenerator.SetSeed(seed)
     sampling = ot.PostAnalyticalImportanceSampling(result)
@@ -122,9 +130,11 @@ def side_probability(fitted: FittedModel, distribution, side: str, limit: float,
         standard_point=list(np.asarray(result.getStandardSpaceDesignPoint(), float)))
 
 
-def _monte_carlo(event, side: str, limit: float, seed: int, note: str) -> LimitEstimate:
+def _monte_carlo(event, side: str, limit: float, seed: int, note: str,
+                 form: float = math.nan, beta: float = math.nan) -> LimitEstimate:
     """Plain Monte Carlo on the metamodel (``MAXIMUM_DRAWS`` draws at most, to the target
-    CV), where FORM has no design point."""
+    CV), where FORM has no design point or the median inputs already fail (then FORM's own
+    figures are kept beside it)."""
     ot = _ot()
     ot.RandomGenerator.SetSeed(seed)
     algorithm = ot.ProbabilitySimulationAlgorithm(event, ot.MonteCarloExperiment())
@@ -134,11 +144,20 @@ def _monte_carlo(event, side: str, limit: float, seed: int, note: str) -> LimitE
     algorithm.run()
     simulated = algorithm.getResult()
     estimate = float(simulated.getProbabilityEstimate())
-    cv = float(simulated.getCoefficientOfVariation()) if estimate > 0 else math.nan
-    return LimitEstimate(side=side, limit=float(limit), form=math.nan, beta=math.nan,
+    draws = int(simulated.getOuterSampling() * simulated.getBlockSize())
+    note += "; plain Monte Carlo on the metamodel"
+    if estimate <= 0:
+        cv = math.nan
+    elif estimate >= 1:
+        # every draw fails: no spread to estimate (OpenTURNS reports a CV of -1); the
+        # binomial rule of three bounds the probability instead
+        cv = 0.0
+        note += f", all {draws} draws fail (P >= {1 - 3 / draws:.6g} at 95 %)"
+    else:
+        cv = float(simulated.getCoefficientOfVariation())
+    return LimitEstimate(side=side, limit=float(limit), form=form, beta=beta,
                          origin_fails=estimate > 0.5, importance=estimate, importance_cv=cv,
-                         draws=int(simulated.getOuterSampling() * simulated.getBlockSize()),
-                         note=note + "; plain Monte Carlo on the metamodel")
+                         draws=draws, note=note)
 
 
 def confirmation_points(distribution, estimate: LimitEstimate, count: int,
