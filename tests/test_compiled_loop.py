@@ -20,9 +20,9 @@ import pytest
 
 from clearbench.adapters.base import RunSettings
 from clearbench.adapters.options import OptionError
+from clearbench.adapters.reference.build import build
 from clearbench.adapters.reference.engine import create
 from clearbench.adapters.reference.step_loop import choose_step_loop
-from clearbench.adapters.reference.build import build
 from clearbench.scenarios.library import get_scene, scene_names
 from clearbench.scenarios.scales import scene_size
 

@@ -83,7 +83,6 @@ def run_compiled(stepper, state, steps: int, recorder, com: np.ndarray, statisti
     ends them: a kernel exception is a crash whose last sample is the failing step's start, a
     non-finite state a divergence."""
     system, settings = compile_system(stepper)
-    h = settings.time_step
     schedule = np.asarray(recorder.schedule, dtype=np.int64)
     record = StepRecord.allocate(system.fixed.shape[0], recorder.contact_force.shape[1],
                                  steps, len(schedule))
