@@ -25,3 +25,12 @@ def test_bench_engines_rejects_bad_input(capsys):
     assert "nope" in capsys.readouterr().err
     assert main(["bench", "engines", "--engine", "mujoco[fast]", "--scene", "pendulum"]) == 2
     assert main(["bench", "engines", "--steps", "0", "--scene", "pendulum"]) == 2
+
+
+def test_bench_engines_takes_an_engine_without_preset(capsys):
+    # "reference" is reference[default]: one contender, not two.
+    assert main(["bench", "engines", "--engine", "reference", "--scene", "pendulum",
+                 "--steps", "2"]) == 0
+    rows = [line for line in capsys.readouterr().out.splitlines()
+            if line.startswith("pendulum")]
+    assert len(rows) == 1 and "reference[default]" in rows[0]

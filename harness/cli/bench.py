@@ -95,8 +95,13 @@ def _contenders(args: argparse.Namespace) -> list[engine_costs.Contender]:
     """The contenders of ``bench engines``, checked before any run (exit 2 naming the bad
     label); reference[default] first, the ratios' denominator."""
     if args.engines:
-        labels = list(_engines(args.engines, {}))
-        contenders = [engine_costs.Contender(*label.rstrip("]").split("[")) for label in labels]
+        contenders = []
+        for label in args.engines:
+            try:
+                choice = resolve_engine(label, field="--engine")
+            except RunInputError as error:
+                raise UserError(str(error)) from None
+            contenders.append(engine_costs.Contender(choice.name, choice.preset))
     else:
         contenders = engine_costs.available_contenders()
     reference = engine_costs.Contender("reference", "default")
