@@ -22,6 +22,7 @@ from clearbench.adapters.recording import SampleRecorder, step_count
 from clearbench.adapters.reference import capabilities
 from clearbench.adapters.reference.build import build
 from clearbench.adapters.reference.settings import OPTIONS, PRESETS, stepper_settings
+from clearbench.adapters.reference.step_loop import choose_step_loop, run_compiled
 from clearbench.adapters.trajectory import RunStatus, Trajectory
 from clearbench.kernels.quaternion import quat_rotate_batch
 from clearbench.ref_solver.stepper import StepperSettings
@@ -86,11 +87,15 @@ class ReferenceEngine(Engine):
         com = np.array([b.center_of_mass for b in scene.bodies], dtype=float)
         statistics = _RunStatistics(config.solver.tolerance)
         recorder.store(*_body_sample(state, com))
+        loop = choose_step_loop(settings.options.get("step_loop", "auto"), stepper)
         build_seconds = time.perf_counter() - start
         status, message = RunStatus.OK, ""
         stepping = 0.0
         taken = 0
-        for k in range(1, steps + 1):
+        if loop.compiled:
+            status, message, stepping, taken = run_compiled(stepper, state, steps, recorder,
+                                                            com, statistics)
+        for k in range(1, 0 if loop.compiled else steps + 1):
             tick = time.perf_counter()
             try:
                 result = stepper.step(state)
@@ -130,6 +135,7 @@ class ReferenceEngine(Engine):
             "contact_sweeps": statistics.contact_sweeps,
             "localise_impacts": config.localise_impacts,
             "split_steps": statistics.split_steps,
+            **loop.metadata(),
         }
         if statistics.unconverged or statistics.unconverged_projection:
             message = "; ".join(filter(None, [message, (

@@ -16,8 +16,9 @@ Options (``RunSettings.options``) override: ``theta``, ``projection``, ``method`
 2 |g| h: slower impacts are plastic), ``joint_law`` (``midpoint`` or ``end``),
 ``localise_impacts`` (true or false; every preset with the projection has it on: an impact
 with e > 0 is applied at its crossing time within the step instead of over the whole step,
-which takes the bouncing-ball apex errors at h = 1e-3 s from 8e-3 to 2e-5) and
-``roundoff_floor``; see :class:`~clearbench.ref_solver.stepper.StepperSettings`.
+which takes the bouncing-ball apex errors at h = 1e-3 s from 8e-3 to 2e-5),
+``roundoff_floor`` and ``step_loop`` (``auto``, ``python`` or ``compiled``:
+:mod:`.step_loop`); see :class:`~clearbench.ref_solver.stepper.StepperSettings`.
 """
 
 from __future__ import annotations
@@ -52,6 +53,7 @@ OPTIONS = OptionTable("reference", (
     choice("joint_law", ("midpoint", "end")),
     boolean("localise_impacts"),
     boolean("roundoff_floor"),
+    choice("step_loop", ("auto", "python", "compiled")),
 ))
 OPTION_NAMES = OPTIONS.names
 

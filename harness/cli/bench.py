@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import statistics
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -21,6 +22,7 @@ from clearbench.harness.run.engine_choice import RunInputError, resolve_engine
 from clearbench.harness.studies.benchmarks import (
     clearance_ladder,
     contact_cost,
+    engine_costs,
     kernel_speed,
     physics,
     physics_table,
@@ -72,6 +74,77 @@ def bench_c60(args: argparse.Namespace) -> int:
               f"{cost.mean_active_contacts:>8.1f} {cost.mean_iterations:>9.0f} "
               f"{cost.median_residual:>10.1e} {cost.max_residual:>8.1e} "
               f"{cost.unconverged_steps:>6}")
+    return 0
+
+
+def _engines_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--engine", action="append", dest="engines", metavar="ENGINE[PRESET]",
+                        help="a contender (repeatable; default every preset of every "
+                        "available engine)")
+    parser.add_argument("--scene", action="append", dest="scenes",
+                        help="a library scene (repeatable; default every library scene)")
+    parser.add_argument("--steps", type=int, default=200,
+                        help="steps of each measured run, at the scene's time step (at most "
+                        "its horizon; default 200)")
+    parser.add_argument("--python-loop", action="store_true",
+                        help="also run reference[default] with step_loop=python (the Python "
+                        "step) beside the compiled loop")
+
+
+def _contenders(args: argparse.Namespace) -> list[engine_costs.Contender]:
+    """The contenders of ``bench engines``, checked before any run (exit 2 naming the bad
+    label); reference[default] first, the ratios' denominator."""
+    if args.engines:
+        contenders = []
+        for label in args.engines:
+            try:
+                choice = resolve_engine(label, field="--engine")
+            except RunInputError as error:
+                raise UserError(str(error)) from None
+            contenders.append(engine_costs.Contender(choice.name, choice.preset))
+    else:
+        contenders = engine_costs.available_contenders()
+    reference = engine_costs.Contender("reference", "default")
+    contenders = [reference] + [c for c in contenders if c != reference]
+    if args.python_loop:
+        contenders.insert(1, engine_costs.Contender("reference", "default",
+                                                    {"step_loop": "python"}))
+    return contenders
+
+
+def bench_engines(args: argparse.Namespace) -> int:
+    scenes = args.scenes or scene_names()
+    missing = sorted(set(scenes) - set(scene_names()))
+    if missing:
+        raise UserError(f"--scene: unknown scene(s) {missing}; see `clearbench list`")
+    if args.steps < 1:
+        raise UserError(f"--steps must be >= 1, got {args.steps}")
+    contenders = _contenders(args)
+    reference = contenders[0].label
+    print(f"Stepping cost per step [us] (stepping_seconds / steps of one run of at most "
+          f"{args.steps} steps, after an untimed warm-up run), and its ratio to {reference}; "
+          "the contenders in turn on each scene, in one process")
+    print(f"{'scene':<27} {'engine[preset]':<36} {'steps':>6} {'us/step':>10} "
+          f"{'x ref':>8}  status")
+    base: dict[str, float] = {}
+
+    def report(cost: engine_costs.EngineCost) -> None:
+        if cost.contender == reference:
+            base[cost.scene] = cost.seconds_per_step
+        ratio = cost.seconds_per_step / base.get(cost.scene, float("nan"))
+        print(f"{cost.scene:<27} {cost.contender:<36} {cost.steps:>6} "
+              f"{1e6 * cost.seconds_per_step:>10.1f} {ratio:>8.3g}  {cost.status}"
+              + (f": {cost.message[:60]}" if cost.message else ""), flush=True)
+
+    costs = engine_costs.measure(scenes, contenders, args.steps, report)
+    ratios = engine_costs.ratios_to(costs, reference)
+    print(f"\nPer contender, over the scenes both ran: median and largest ratio to {reference}")
+    for contender in contenders[1:]:
+        values = [r for (_, label), r in ratios.items() if label == contender.label
+                  and r == r]
+        if values:
+            print(f"  {contender.label:<36} median {statistics.median(values):.3g}, "
+                  f"range {min(values):.3g}-{max(values):.3g} over {len(values)} scenes")
     return 0
 
 
@@ -344,6 +417,9 @@ BENCHMARKS: dict[str, Benchmark] = {
     "c60": Benchmark("wall time and solver statistics of full c60-trip and c60-on runs "
                      "(--against REV: a baseline revision side by side)",
                      bench_c60, bench_against.add_arguments),
+    "engines": Benchmark(
+        "stepping cost per step of every engine[preset] on every library scene, side by "
+        "side, with the ratio to the reference", bench_engines, _engines_options),
     "newton-first": Benchmark(
         "the hybrid solver with and without 'Newton first after a step that needed it' (c60-on)",
         bench_newton_first, _newton_first_options),

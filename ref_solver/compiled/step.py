@@ -1,0 +1,217 @@
+"""One Moreau–Jean step with the combined projection, compiled: steps 1-5 of
+:mod:`clearbench.ref_solver.stepper` (free velocity, velocity stage with the contact solve,
+position update, projection, activation loop), as ``MoreauJeanStepper._single_step`` without
+impact localisation, by the same kernels.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from clearbench.ref_solver.compiled.contact_solve import solve
+from clearbench.ref_solver.constraints import contact_rows, row_values
+from clearbench.ref_solver.forces import rotation_matrices
+from clearbench.ref_solver.gyroscopic import integrate_orientations
+from clearbench.ref_solver.projection_kernel import candidates, project
+from clearbench.ref_solver.step_kernels import free_velocity, velocity_problem
+
+
+@njit(cache=True)
+def valid_slots(count, mask):
+    """``mask`` (npair, K) restricted to the slots that hold a candidate (``count`` (npair,))."""
+    out = mask.copy()
+    for i in range(mask.shape[0]):
+        for k in range(count[i], mask.shape[1]):
+            out[i, k] = False
+    return out
+
+
+@njit(cache=True)
+def _selected(mask):
+    """(pairs, slots) int64 of the true entries of ``mask`` (npair, K), pair-major."""
+    n = 0
+    for i in range(mask.shape[0]):
+        for k in range(mask.shape[1]):
+            n += mask[i, k]
+    pairs = np.empty(n, dtype=np.int64)
+    slots = np.empty(n, dtype=np.int64)
+    j = 0
+    for i in range(mask.shape[0]):
+        for k in range(mask.shape[1]):
+            if mask[i, k]:
+                pairs[j] = i
+                slots[j] = k
+                j += 1
+    return pairs, slots
+
+
+@njit(cache=True)
+def _normal_velocity(s, x, rotation, cand, nu):
+    """Normal velocity (npair, K) [L/T] of every candidate at twist ``nu`` (nb, 6)
+    (``MoreauJeanStepper._normal_velocity``; the contact rows alone: they do not depend on
+    the bilateral rows before them)."""
+    out = np.zeros_like(cand[0])
+    pairs, slots = _selected(valid_slots(cand[4], np.ones(cand[0].shape, dtype=np.bool_)))
+    nc = pairs.shape[0]
+    if nc == 0:
+        return out
+    m = 3 * nc
+    row_body = np.full((m, 2), -1, dtype=np.int64)
+    row_coef = np.zeros((m, 2, 6))
+    g = s.geometry
+    contact_rows(x, rotation, s.fixed, g[3], g[6], g[7], pairs, slots, cand[1], cand[2],
+                 cand[3], row_body, row_coef, 0)
+    values = row_values(row_body, row_coef, nu, 0, m)
+    for c in range(nc):
+        out[pairs[c], slots[c]] = values[3 * c]
+    return out
+
+
+@njit(cache=True)
+def _finite(a):
+    for value in a.ravel():
+        if not np.isfinite(value):
+            return False
+    return True
+
+
+@njit(cache=True)
+def _velocity_stage(s, cfg, memory, t, h, x, p, v, omega, rotation, nu, free, inverse, cand,
+                    active, history):
+    """``MoreauJeanStepper._velocity_stage``: (x, p, v, omega at t + h, impulses
+    (npair, K, 3), closed (npair, K), solver iterations, residual, converged, sweeps)."""
+    previous_impulse, previous_bilateral, newton_first = memory[0], memory[1], memory[2]
+    theta = cfg.theta
+    pairs, slots = _selected(valid_slots(cand[4], active))
+    nc = pairs.shape[0]
+    nbil = s.n_bilateral
+    m = nbil + 3 * nc
+    new_nu = free.copy()
+    impulses = np.zeros_like(previous_impulse)
+    closed = np.zeros(active.shape, dtype=np.bool_)
+    iterations, residual, converged, sweeps = 0, 0.0, True, 0
+    if m:
+        w, y, q, row_body, row_coef, _, _ = velocity_problem(
+            s.geometry, nbil, s.n_joint_rows, t + h, h, theta, x, p, v, omega, rotation,
+            cand[1], cand[2], cand[3], pairs, slots, nu, free, inverse, s.cluster,
+            s.cluster_dofs, s.cluster_start, s.pair_restitution, cfg.restitution_threshold,
+            cfg.midpoint_joints)
+        if not (_finite(q) and _finite(w)):
+            raise ValueError("the one-step contact problem has a non-finite W or q")
+        r0 = np.empty(m)
+        r0[:nbil] = previous_bilateral
+        mu = np.empty(nc)
+        for c in range(nc):
+            mu[c] = s.pair_friction[pairs[c]]
+            for a in range(3):
+                r0[nbil + 3 * c + a] = previous_impulse[pairs[c], slots[c], a]
+        r, iterations, residual, converged = solve(w, q, mu, nbil, r0, cfg, newton_first,
+                                                   history)
+        sweeps = iterations * nc
+        new_nu = free + (y @ r).reshape(-1, 6)
+        previous_bilateral[:] = r[:nbil]
+        for c in range(nc):
+            for a in range(3):
+                impulses[pairs[c], slots[c], a] = r[nbil + 3 * c + a]
+        if nc:
+            # Contacts that stay closed: a normal impulse and no rebound (see the stepper).
+            u_new = row_values(row_body, row_coef, new_nu, nbil, m)
+            largest = 0.0
+            for c in range(nc):
+                largest = max(largest, abs(r[nbil + 3 * c]))
+            floor = 1e-14 * max(largest, 1e-300)
+            for c in range(nc):
+                closed[pairs[c], slots[c]] = (r[nbil + 3 * c] > floor) and (
+                    u_new[3 * c] <= 0.5 * cfg.restitution_threshold)
+    for b in range(s.fixed.shape[0]):
+        if s.fixed[b]:
+            new_nu[b] = 0.0
+    v_theta = theta * new_nu + (1.0 - theta) * nu
+    x_new = x + h * v_theta[:, :3]
+    p_new = integrate_orientations(p, np.ascontiguousarray(h * v_theta[:, 3:]), s.fixed)
+    return (x_new, p_new, new_nu[:, :3].copy(), new_nu[:, 3:].copy(), impulses, closed,
+            iterations, residual, converged, sweeps)
+
+
+@njit(cache=True)
+def _projection_stage(s, cfg, t, x, p, active, closed):
+    """``MoreauJeanStepper._projection_stage`` on (x, p) in place: (iterations, largest
+    violation [L], converged); contacts of ``closed`` as equalities, retried unilateral."""
+    start_x, start_p = x.copy(), p.copy()
+    iterations, worst, converged = project(
+        s.geometry, s.n_bilateral, t, x, p, active, closed, s.projection_inverse,
+        s.single_cluster, s.single_dofs, s.single_start, cfg.position_tolerance,
+        cfg.max_projection_iterations)
+    if converged or not closed.any():
+        return iterations, worst, converged
+    best_worst, best_x, best_p = worst, x.copy(), p.copy()
+    x[:] = start_x
+    p[:] = start_p
+    more, worst, converged = project(
+        s.geometry, s.n_bilateral, t, x, p, active, np.zeros_like(closed),
+        s.projection_inverse, s.single_cluster, s.single_dofs, s.single_start,
+        cfg.position_tolerance, cfg.max_projection_iterations)
+    iterations += more
+    if not converged and best_worst < worst:
+        worst = best_worst
+        x[:] = best_x
+        p[:] = best_p
+    return iterations, worst, converged
+
+
+@njit(cache=True)
+def single_step(s, cfg, memory, t, x, p, v, omega, history):
+    """One step of length ``cfg.time_step`` from (t, x (nb, 3), p (nb, 4), v (nb, 3), omega
+    (nb, 3)) (not modified).
+
+    ``memory`` = (previous impulses (npair, K, 3), previous bilateral impulses (nbil,), the
+    hybrid chain's ``newton_first`` (1,)), the warm starts, updated in place. Returns (x, p, v,
+    omega at t + h, impulses (npair, K, 3) in the contact frames [F T], frames (npair, K, 3, 3)
+    of the contacts at the start of the step, active (npair, K), solver iterations, residual,
+    converged, projection converged, contact sweeps).
+    """
+    h = cfg.time_step
+    theta = cfg.theta
+    rotation = rotation_matrices(p)
+    nb = x.shape[0]
+    nu = np.empty((nb, 6))
+    nu[:, :3] = v
+    nu[:, 3:] = omega
+    free, inverse, _ = free_velocity(
+        t + theta * h, h, theta, x, p, rotation, v, omega, s.mass, s.inertia,
+        s.inverse_inertia, s.gravity, s.fixed, s.force_kind, s.force_body_a, s.force_body_b,
+        s.force_parameters, memory[3], s.has_springs, cfg.length_step, s.mass_matrix,
+        s.inverse_mass, s.cluster_dofs, s.cluster_start)
+    cand = candidates(s.geometry, x, rotation)
+    if cfg.projection:
+        active = valid_slots(cand[4], cand[0] <= cfg.activation_margin)
+    else:
+        u_normal = _normal_velocity(s, x, rotation, cand, nu)
+        active = valid_slots(cand[4], cand[0] + 0.5 * h * u_normal <= cfg.activation_margin)
+    iterations, sweeps, rounds = 0, 0, 0
+    projection_converged = True
+    while True:
+        rounds += 1
+        (x_new, p_new, v_new, omega_new, impulses, closed, its, residual, converged,
+         more_sweeps) = _velocity_stage(s, cfg, memory, t, h, x, p, v, omega, rotation, nu,
+                                        free, inverse, cand, active, history)
+        iterations += its
+        sweeps += more_sweeps
+        if not cfg.projection:
+            break
+        _, _, projection_converged = _projection_stage(s, cfg, t + h, x_new, p_new, active,
+                                                       closed)
+        cand_new = candidates(s.geometry, x_new, rotation_matrices(p_new))
+        closing = valid_slots(cand_new[4], cand_new[0] <= 0.0) & ~active
+        if not closing.any() or rounds >= cfg.max_activation_rounds:
+            break
+        active = active | closing
+    previous_impulse = memory[0]
+    previous_impulse[:] = 0.0
+    for i in range(active.shape[0]):
+        for k in range(active.shape[1]):
+            if active[i, k]:
+                previous_impulse[i, k] = impulses[i, k]
+    return (x_new, p_new, v_new, omega_new, impulses, cand[3], active, iterations, residual,
+            converged, projection_converged, sweeps)

@@ -1,0 +1,36 @@
+"""``clearbench bench engines``: the contenders side by side with the ratio to the reference,
+bad input refused with status 2 before any run (nothing is asserted about time)."""
+
+from __future__ import annotations
+
+from clearbench.harness.cli.main import main
+
+
+def test_bench_engines_prints_each_contender_and_its_ratio(capsys):
+    status = main(["bench", "engines", "--engine", "mujoco[default]", "--scene", "pendulum",
+                   "--steps", "3", "--python-loop"])
+    assert status == 0
+    out = capsys.readouterr().out
+    rows = [line.split() for line in out.splitlines() if line.startswith("pendulum")]
+    labels = [" ".join(row[1:-4]) for row in rows]
+    assert labels == ["reference[default]", "reference[default] step_loop=python",
+                      "mujoco[default]"]
+    assert all(row[-4] == "3" and row[-1] == "ok" for row in rows)
+    assert rows[0][-2] == "1"  # the reference's ratio to itself
+    assert "median" in out
+
+
+def test_bench_engines_rejects_bad_input(capsys):
+    assert main(["bench", "engines", "--scene", "nope"]) == 2
+    assert "nope" in capsys.readouterr().err
+    assert main(["bench", "engines", "--engine", "mujoco[fast]", "--scene", "pendulum"]) == 2
+    assert main(["bench", "engines", "--steps", "0", "--scene", "pendulum"]) == 2
+
+
+def test_bench_engines_takes_an_engine_without_preset(capsys):
+    # "reference" is reference[default]: one contender, not two.
+    assert main(["bench", "engines", "--engine", "reference", "--scene", "pendulum",
+                 "--steps", "2"]) == 0
+    rows = [line for line in capsys.readouterr().out.splitlines()
+            if line.startswith("pendulum")]
+    assert len(rows) == 1 and "reference[default]" in rows[0]
