@@ -15,7 +15,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-import clearbench
 from clearbench.adapters.base import Capability, Engine, RunSettings
 from clearbench.adapters.options import OptionError
 from clearbench.adapters.recording import SampleRecorder, step_count
@@ -28,14 +27,11 @@ from clearbench.ref_solver.stepper import StepperSettings
 from clearbench.ref_solver.system import State
 from clearbench.scenarios.scene import Scene
 
-__all__ = ["OPTIONS", "PRESETS", "ReferenceEngine", "availability", "create"]
-
-
-def availability() -> tuple[bool, str]:
-    return True, f"built in (clearbench {clearbench.__version__})"
+__all__ = ["OPTIONS", "PRESETS", "ReferenceEngine", "create"]
 
 
 def create(preset: str = "default") -> ReferenceEngine:
+    """A :class:`ReferenceEngine` with ``preset`` (ValueError for an unknown one)."""
     return ReferenceEngine(preset)
 
 
