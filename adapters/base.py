@@ -90,9 +90,10 @@ class RunSettings:
 
 @dataclass(frozen=True)
 class FeatureQuery:
-    """What the capability hooks of an engine are asked about: the scene and the run options.
-    Engines that derive more from them once per scene (a MuJoCo tree plan, resolved settings)
-    return their own object from :meth:`Engine.feature_context`."""
+    """What the capability hooks of an engine are asked about: the scene and the run options
+    (for a :class:`ModuleEngine`, its settings resolved from the preset and the options).
+    Engines that derive more from them once per scene (a MuJoCo tree plan) return their own
+    object from :meth:`Engine.feature_context`."""
 
     scene: Scene
     options: Mapping = field(default_factory=dict)
@@ -231,9 +232,11 @@ class Engine(ABC):
 class ModuleEngine(Engine):
     """An engine whose run options are the fields of one settings object resolved from its
     preset (:attr:`RESOLVE_SETTINGS`), and whose capability hooks are the functions of one
-    module (:attr:`CAPABILITIES`: ``feature_context(scene, settings)``,
-    ``feature_problems(context)``, ``plain_capability``, ``shape_capability``,
-    ``joint_capability``, ``pair_capability``), as the MuJoCo and PyBullet adapters are built.
+    module (:attr:`CAPABILITIES`: ``plain_capability``, ``shape_capability``,
+    ``joint_capability``, ``pair_capability``, each taking the context first, and where the
+    engine needs them ``feature_context(scene, settings)`` (default: a :class:`FeatureQuery`
+    of the scene and the resolved settings) and ``feature_problems(context)`` (default:
+    none)), as every engine of the repository is built.
     """
 
     #: The engine's capabilities module.
@@ -257,10 +260,13 @@ class ModuleEngine(Engine):
 
     def feature_context(self, scene: Scene, options: Mapping) -> Any:
         settings = self.settings(options)
-        return self.CAPABILITIES.feature_context(self.capability_scene(scene, settings), settings)
+        scene = self.capability_scene(scene, settings)
+        make = getattr(self.CAPABILITIES, "feature_context", None)
+        return make(scene, settings) if make else FeatureQuery(scene, settings)
 
     def feature_problems(self, context) -> Mapping[str, Sequence[str]]:
-        return self.CAPABILITIES.feature_problems(context)
+        problems = getattr(self.CAPABILITIES, "feature_problems", None)
+        return problems(context) if problems else {}
 
     def plain_capability(self, context, name: str) -> Capability | None:
         return self.CAPABILITIES.plain_capability(context, name)

@@ -15,12 +15,17 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from clearbench.adapters.base import Capability, Engine, RunSettings
+from clearbench.adapters.base import ModuleEngine, RunSettings
 from clearbench.adapters.options import OptionError
 from clearbench.adapters.recording import SampleRecorder, step_count
 from clearbench.adapters.reference import capabilities
 from clearbench.adapters.reference.build import build
-from clearbench.adapters.reference.settings import OPTIONS, PRESETS, stepper_settings
+from clearbench.adapters.reference.settings import (
+    OPTIONS,
+    PRESETS,
+    resolve_settings,
+    stepper_settings,
+)
 from clearbench.adapters.trajectory import RunStatus, Trajectory
 from clearbench.kernels.quaternion import quat_rotate_batch
 from clearbench.ref_solver.stepper import StepperSettings
@@ -35,25 +40,15 @@ def create(preset: str = "default") -> ReferenceEngine:
     return ReferenceEngine(preset)
 
 
-class ReferenceEngine(Engine):
+class ReferenceEngine(ModuleEngine):
     """Our nonsmooth reference solver (see :mod:`clearbench.ref_solver.stepper`)."""
 
     name = "reference"
     RIGID_CONTACTS = True
     PRESETS = PRESETS
     OPTIONS = OPTIONS
-
-    def plain_capability(self, context, name: str) -> Capability | None:
-        return capabilities.plain_capability(name)
-
-    def shape_capability(self, context, kind: str) -> Capability | None:
-        return capabilities.shape_capability(kind)
-
-    def joint_capability(self, context, kind: str) -> Capability | None:
-        return capabilities.joint_capability(kind)
-
-    def pair_capability(self, context, kind_a: str, kind_b: str) -> Capability | None:
-        return capabilities.pair_capability(kind_a, kind_b)
+    CAPABILITIES = capabilities
+    RESOLVE_SETTINGS = staticmethod(resolve_settings)
 
     def check_option_combination(self, options: Mapping) -> None:
         # An explicit localise_impacts = true needs the projection (without it, the preset's

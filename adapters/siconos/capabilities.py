@@ -1,11 +1,10 @@
 """What each scene feature becomes in the Siconos engine: native, approximated (how) or
 unsupported (why), one function per feature kind (wired by
-:class:`~clearbench.adapters.base.ModuleEngine`)."""
+:class:`~clearbench.adapters.base.ModuleEngine`; the context is a
+:class:`~clearbench.adapters.base.FeatureQuery` whose ``options`` are the resolved settings,
+:func:`~.settings.resolve_settings`)."""
 
 from __future__ import annotations
-
-from collections.abc import Mapping
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -13,25 +12,6 @@ from clearbench.adapters.base import Capability, Support
 from clearbench.adapters.siconos.worker import geometry as worker_geometry
 from clearbench.kernels.quaternion import quat_normalize, quat_to_matrix
 from clearbench.scenarios.scene import Scene
-
-
-@dataclass(frozen=True)
-class FeatureContext:
-    """What the capability functions are asked about: the scene and the resolved settings
-    (:func:`~.settings.resolve_settings`)."""
-
-    scene: Scene
-    settings: Mapping
-
-
-def feature_context(scene: Scene, settings: Mapping) -> FeatureContext:
-    return FeatureContext(scene, settings)
-
-
-def feature_problems(context: FeatureContext) -> dict[str, list[str]]:
-    """None: every feature is answered by its kind's function."""
-    return {}
-
 
 _JOINT_CLASSES = {"revolute": "PivotJointR", "spherical": "KneeJointR",
                   "prismatic": "PrismaticJointR", "fixed": "FixedJointR"}
@@ -120,7 +100,7 @@ def pair_capability(context, kind_a: str, kind_b: str) -> Capability | None:
     if kind_a not in known or kind_b not in known:
         return None
     # The preset's projection, or the run option's.
-    return _pair_capability(kind_a, kind_b, bool(context.settings["projection"]))
+    return _pair_capability(kind_a, kind_b, bool(context.options["projection"]))
 
 
 def driver_capability(scene: Scene) -> Capability:
