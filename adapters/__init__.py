@@ -4,7 +4,9 @@ One subpackage per engine, with the same module names (``engine.py``; ``build.py
 ``capabilities.py``, ``settings.py`` ... where the engine has them) and the same entry points
 in its ``__init__``: ``availability() -> (bool, str)`` and ``create(preset) -> Engine`` (the
 contract: :mod:`clearbench.adapters.base`). :data:`ENGINES` lists them; nothing here imports an
-engine subpackage (or an engine's Python package) until it is asked about.
+engine subpackage until it is asked about, and asking about availability imports neither the
+adapter's modules nor the engine's Python package (:func:`installed_package`,
+:func:`lazy_engine`): ``clearbench list`` stays quick.
 
 Adding an engine: a subpackage with those two functions and an
 :class:`~clearbench.adapters.base.Engine` subclass, and its line in :data:`ENGINES`; the
@@ -14,7 +16,11 @@ engine-contract test then runs it over every library scene.
 from __future__ import annotations
 
 import importlib
+import importlib.metadata
+import importlib.util
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 #: Engine name -> its subpackage.
 ENGINES: dict[str, str] = {
@@ -51,3 +57,50 @@ def engine_availability(engine: str) -> Availability:
 def all_availability() -> list[Availability]:
     """Availability of every engine of :data:`ENGINES`, in their order."""
     return [engine_availability(name) for name in ENGINES]
+
+
+def installed_package(import_name: str, distribution: str | None = None) -> tuple[bool, str]:
+    """(True, ``"NAME VERSION"``) when the package ``import_name`` is installed, else (False,
+    why); found without importing it (an engine's package takes up to a second to import).
+
+    Parameters
+    ----------
+    import_name : str
+        The name ``import`` takes (``mujoco``).
+    distribution : str, optional
+        The distribution that installs it, for its version (default: ``import_name``).
+    """
+    if importlib.util.find_spec(import_name) is None:
+        return False, f"{import_name} is not installed"
+    try:
+        return True, f"{import_name} {importlib.metadata.version(distribution or import_name)}"
+    except importlib.metadata.PackageNotFoundError:  # a source build without metadata
+        return True, f"{import_name} (version unknown)"
+
+
+def lazy_engine(package: str, *names: str) -> tuple[Callable[..., Any], Callable[[str], Any]]:
+    """``create`` and a module ``__getattr__`` for the engine subpackage ``package`` whose
+    ``engine`` module defines ``create(preset)`` and ``names``: the adapter's modules are
+    imported when an engine is created or one of ``names`` is read, not when the subpackage is
+    imported for its availability.
+
+    Returns
+    -------
+    create : callable
+        ``package.engine.create``, imported on the first call.
+    getattr : callable
+        The subpackage's ``__getattr__`` (PEP 562) serving ``names`` from ``package.engine``.
+    """
+    def engine_module():
+        return importlib.import_module(f"{package}.engine")
+
+    def create(preset: str = "default"):
+        return engine_module().create(preset)
+
+    def module_getattr(name: str):
+        if name in names:
+            return getattr(engine_module(), name)
+        raise AttributeError(f"module {package!r} has no attribute {name!r}")
+
+    create.__doc__ = f"``{package}.engine.create(preset)``: an engine with that preset."
+    return create, module_getattr

@@ -30,15 +30,19 @@ or bad option value).
 from __future__ import annotations
 
 import enum
+import time
 from abc import ABC, abstractmethod
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 from clearbench.adapters.options import OptionTable
+from clearbench.adapters.recording import step_count
 from clearbench.adapters.trajectory import RunStatus, Trajectory
 from clearbench.scenarios.features import FeatureKind, parse_feature
 from clearbench.scenarios.scene import Scene
+from clearbench.scenarios.units import SI
+from clearbench.scenarios.validation import TIME
 
 
 class Support(enum.Enum):
@@ -86,9 +90,10 @@ class RunSettings:
 
 @dataclass(frozen=True)
 class FeatureQuery:
-    """What the capability hooks of an engine are asked about: the scene and the run options.
-    Engines that derive more from them once per scene (a MuJoCo tree plan, resolved settings)
-    return their own object from :meth:`Engine.feature_context`."""
+    """What the capability hooks of an engine are asked about: the scene and the run options
+    (for a :class:`ModuleEngine`, its settings resolved from the preset and the options).
+    Engines that derive more from them once per scene (a MuJoCo tree plan) return their own
+    object from :meth:`Engine.feature_context`."""
 
     scene: Scene
     options: Mapping = field(default_factory=dict)
@@ -227,9 +232,11 @@ class Engine(ABC):
 class ModuleEngine(Engine):
     """An engine whose run options are the fields of one settings object resolved from its
     preset (:attr:`RESOLVE_SETTINGS`), and whose capability hooks are the functions of one
-    module (:attr:`CAPABILITIES`: ``feature_context(scene, settings)``,
-    ``feature_problems(context)``, ``plain_capability``, ``shape_capability``,
-    ``joint_capability``, ``pair_capability``), as the MuJoCo and PyBullet adapters are built.
+    module (:attr:`CAPABILITIES`: ``plain_capability``, ``shape_capability``,
+    ``joint_capability``, ``pair_capability``, each taking the context first, and where the
+    engine needs them ``feature_context(scene, settings)`` (default: a :class:`FeatureQuery`
+    of the scene and the resolved settings) and ``feature_problems(context)`` (default:
+    none)), as every engine of the repository is built.
     """
 
     #: The engine's capabilities module.
@@ -253,10 +260,13 @@ class ModuleEngine(Engine):
 
     def feature_context(self, scene: Scene, options: Mapping) -> Any:
         settings = self.settings(options)
-        return self.CAPABILITIES.feature_context(self.capability_scene(scene, settings), settings)
+        scene = self.capability_scene(scene, settings)
+        make = getattr(self.CAPABILITIES, "feature_context", None)
+        return make(scene, settings) if make else FeatureQuery(scene, settings)
 
     def feature_problems(self, context) -> Mapping[str, Sequence[str]]:
-        return self.CAPABILITIES.feature_problems(context)
+        problems = getattr(self.CAPABILITIES, "feature_problems", None)
+        return problems(context) if problems else {}
 
     def plain_capability(self, context, name: str) -> Capability | None:
         return self.CAPABILITIES.plain_capability(context, name)
@@ -269,3 +279,89 @@ class ModuleEngine(Engine):
 
     def pair_capability(self, context, kind_a: str, kind_b: str) -> Capability | None:
         return self.CAPABILITIES.pair_capability(context, kind_a, kind_b)
+
+
+class BuildError(Exception):
+    """The engine refused the scene while building it: a CRASHED run with this message
+    (raised by :meth:`SteppingEngine.build`)."""
+
+
+class SteppingEngine(ModuleEngine):
+    """A :class:`ModuleEngine` that steps in this process. The base does the bookkeeping of a
+    run (scipy's ``OdeSolver.step`` / ``_step_impl`` model): settings resolved once, the scene
+    in the engine's internal units, step and horizon converted to them, build and stepping
+    timed apart, the recorded samples converted back into a :class:`Trajectory`. The engine
+    supplies the hooks :meth:`build`, :meth:`runner` and :meth:`metadata` (and, where it needs
+    them, :meth:`internal_scene`, :meth:`step`, :meth:`release`, :meth:`steps_taken`).
+
+    The runner a hook returns has ``run() -> (RunStatus, message)``, a ``recorder``
+    (:class:`~clearbench.adapters.recording.SampleRecorder`), ``stepping_seconds`` and
+    ``steps_taken``.
+    """
+
+    #: The engine's name in prose (``"MuJoCo"``), for notes of the run.
+    TITLE: ClassVar[str] = ""
+
+    def _run(self, scene: Scene, settings: RunSettings) -> Trajectory:
+        config = self.settings(settings.options)
+        start = time.perf_counter()
+        internal = self.internal_scene(scene, config)
+        to_internal = scene.units.factor_to(internal.units, TIME)
+        dt = (settings.time_step or scene.time_step) * to_internal
+        horizon = (settings.horizon or scene.horizon) * to_internal
+        steps = step_count(horizon, dt)
+        try:
+            built = self.build(internal, config, dt)
+        except BuildError as error:
+            return Trajectory.empty(self.name, self.preset, scene, RunStatus.CRASHED,
+                                    str(error), time_step=dt / to_internal)
+        try:
+            runner = self.runner(internal, built, config, steps, settings.record_every)
+            build_seconds = time.perf_counter() - start
+            status, message = self.step(runner)
+        finally:
+            self.release(built)
+        return runner.recorder.trajectory(
+            scene, dt, recorded_units=internal.units, engine=self.name, preset=self.preset,
+            build_seconds=build_seconds, stepping_seconds=runner.stepping_seconds,
+            steps=self.steps_taken(runner, steps, dt), status=status, message=message,
+            metadata=self.metadata(scene, internal, config, built, runner))
+
+    # ------------------------------------------------------------------ hooks
+    def internal_scene(self, scene: Scene, config) -> Scene:
+        """The scene in the units the engine works in (default: SI when the settings'
+        ``internal_units`` is ``"SI"``, else the scene's own)."""
+        if config.internal_units == "SI" and scene.units != SI:
+            return scene.rescaled(SI)
+        return scene
+
+    @abstractmethod
+    def build(self, internal: Scene, config, dt: float) -> Any:
+        """The engine's model of ``internal`` with step ``dt`` (internal units); BuildError
+        when the engine refuses it."""
+
+    @abstractmethod
+    def runner(self, internal: Scene, built, config, steps: int, record_every: int) -> Any:
+        """The step loop of the run (see the class docstring)."""
+
+    @abstractmethod
+    def metadata(self, scene: Scene, internal: Scene, config, built, runner) -> dict:
+        """The engine's notes of the run (settings, guards, solver statistics, ...)."""
+
+    def step(self, runner) -> tuple[RunStatus, str]:
+        """Run the loop; (status, message) of its end."""
+        return runner.run()
+
+    def release(self, built) -> None:
+        """Free what the model holds outside Python (default: nothing)."""
+
+    def steps_taken(self, runner, steps: int, dt: float) -> int:
+        """Steps the run took of its ``steps`` of ``dt`` (default: as the runner counted)."""
+        return runner.steps_taken
+
+    def units_note(self, scene: Scene, internal: Scene) -> str:
+        """The metadata's ``units``: the units the engine ran in."""
+        if internal.units != scene.units:
+            return (f"scene in {scene.units.describe()} rescaled to "
+                    f"{internal.units.describe()} for {self.TITLE}; results converted back")
+        return f"run in the scene's units ({scene.units.describe()})"

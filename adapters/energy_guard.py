@@ -1,9 +1,11 @@
 """The energy guard every stepping adapter runs: on scenes whose expectations say energy may
 only decrease, an energy gain above a fraction of the energy scale stops the run as diverged.
 
-Engine-neutral: the engine computes the mechanical energy it can count (kinetic, gravity,
-springs) and feeds it here; this module decides whether the guard applies, keeps the energy
-scale and words the stop.
+Engine-neutral: the engine computes the mechanical energy of its state
+(:func:`clearbench.scenarios.energy.mechanical_energy`: kinetic, gravity, springs) and feeds it
+here; this module decides whether the guard applies (not while loads do work that energy does
+not count: :data:`~clearbench.scenarios.features.WORK_FEATURES`, and torsional springs for an
+engine that cannot measure their angle), keeps the energy scale and words the stop.
 """
 
 from __future__ import annotations
@@ -15,14 +17,10 @@ from clearbench.scenarios.features import WORK_FEATURES
 from clearbench.scenarios.scales import largest_shape_dimension
 from clearbench.scenarios.scene import Scene
 
-__all__ = ["ENERGY_EXPECTATIONS", "SPRING_WORK_FEATURES", "WORK_FEATURES", "EnergyGuard"]
+__all__ = ["ENERGY_EXPECTATIONS", "EnergyGuard"]
 
 #: Expectation kinds under which the energy of the scene may not grow.
 ENERGY_EXPECTATIONS = ("energy_non_increasing", "energy_conserved")
-# WORK_FEATURES (scenarios.features): features doing work an energy balance does not count
-# (the guard stays off).
-#: The same plus torsional springs, for engines whose energy counts linear springs only.
-SPRING_WORK_FEATURES = (*WORK_FEATURES, "torsional_springs")
 
 
 class EnergyGuard:
@@ -36,8 +34,9 @@ class EnergyGuard:
         Gain above ``tolerance`` x the energy scale stops the run.
     interval : int
         Steps between checks (the engine also checks at every recorded sample).
-    work_features : tuple of str
-        Features doing work the engine's energy does not count.
+    counts_torsional_springs : bool
+        Whether the engine's energy counts torsional springs (it passes their angles to
+        ``mechanical_energy``); if not, they do work it does not count.
 
     Attributes
     ----------
@@ -50,14 +49,16 @@ class EnergyGuard:
     """
 
     def __init__(self, scene: Scene, tolerance: float, interval: int,
-                 work_features: tuple = WORK_FEATURES):
+                 counts_torsional_springs: bool = True):
         self.tolerance = tolerance
         self.interval = interval
         self.notes: list[str] = []
         self.energy_initial = float("nan")
         self.max_gain = 0.0
         self._kinetic_max = 0.0
-        self.applies = self._applies(scene, work_features)
+        uncounted = WORK_FEATURES if counts_torsional_springs else (*WORK_FEATURES,
+                                                                     "torsional_springs")
+        self.applies = self._applies(scene, uncounted)
         mass = sum(b.mass for b in scene.bodies if b.motion is not Motion.FIXED)
         gravity = float(np.linalg.norm(np.asarray(scene.gravity, dtype=float)))
         #: sum(m |g|) over the moving bodies x the largest shape dimension [M L^2/T^2].

@@ -3,11 +3,8 @@ and the marker for tests that need the shared metrics (they need the geometry mo
 
 from __future__ import annotations
 
-import importlib.util
 import os
 from pathlib import Path
-
-import pytest
 
 from clearbench.scenarios.bodies import Body
 from clearbench.scenarios.inertia import solid_sphere
@@ -19,10 +16,6 @@ ROOT = Path(__file__).resolve().parent.parent
 FAKE = {"fake": "tests.fake_engine"}
 FAKE_OPTION = ["--engine-module", "fake=tests.fake_engine"]
 
-metrics_available = importlib.util.find_spec("clearbench.scenarios.geometry") is not None
-needs_metrics = pytest.mark.skipif(
-    not metrics_available,
-    reason="harness.metrics needs clearbench.scenarios.geometry, which has not landed yet")
 
 
 def probe_scene(horizon: float = 1.0, time_step: float = 1e-2) -> Scene:

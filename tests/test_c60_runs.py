@@ -1,6 +1,6 @@
 """The C-60 with the reference engine: short runs in the default suite, full runs marked slow.
 
-Penetration is measured by the shared geometry (harness.metrics), never taken from the engine.
+Penetration is measured by the shared geometry (harness.measure), never taken from the engine.
 """
 
 from __future__ import annotations
@@ -163,7 +163,7 @@ def test_trip_opens_the_contacts(trip_run):
 def test_trip_has_no_penetration_over_the_whole_run(trip_run):
     # The whole 20 ms, including the handle turning freely after the trip (the source has no
     # OFF stop; its ON-stop face comes round behind the case's stop pins, which the faces'
-    # depth keeps from counting as a contact, see c60_model.FACE_DEPTH).
+    # depth keeps from counting as a contact, see scenarios.c60.model.FACE_DEPTH).
     scene, trajectory = trip_run
     assert metrics.penetration(scene, trajectory).max() <= PENETRATION_LIMIT
     # The few steps whose projection did not reach its tolerance are listed (4 of 20000

@@ -1,4 +1,4 @@
-"""The C-60 model's documented alternatives (issue 18): named variants and validated overrides
+"""The C-60 model's documented alternatives: named variants and validated overrides
 reach the scene's laws and friction, bad values are refused naming the field, the default is
 the source's model, and a campaign takes a variant through its scene_parameters."""
 

@@ -105,7 +105,7 @@ def test_nsgs_with_exact_local_solver_on_shipped_problems(name):
 
 @pytest.mark.parametrize("name", sorted(PROBLEMS))
 def test_newton_solves_every_shipped_problem(name):
-    # including the two NSGS cannot solve (done-when of issue 4)
+    # including the two NSGS cannot solve
     problem = load_problem(DATA / name).problem
     result = solve_contact_problem(problem, SolverOptions(
         method="newton", tolerance=TOL, normalisation="q", max_iterations=500))

@@ -9,7 +9,7 @@ from clearbench.harness.run.engine_choice import RunInputError
 from clearbench.harness.run.store import ResultsStore
 from clearbench.harness.studies.sweep import LadderStep, parse_ladder
 
-from .harness_helpers import FAKE_OPTION, needs_metrics, write_probe
+from .harness_helpers import FAKE_OPTION, write_probe
 
 COMMANDS = ("run", "sweep", "stability", "compare", "report", "regress")
 
@@ -75,7 +75,6 @@ def test_sweep_prints_points_per_engine(tmp_path, capsys):
     assert "fake[default] (fine ref)" in out and "diverged" in out
 
 
-@needs_metrics
 def test_error_against_the_fine_reference_falls_with_the_step(tmp_path):
     scene = write_probe(tmp_path)
     store_dir = tmp_path / "store"

@@ -16,7 +16,7 @@ from clearbench.harness.studies.regress import (
     updated_baseline,
 )
 
-from .harness_helpers import FAKE_OPTION, needs_metrics
+from .harness_helpers import FAKE_OPTION
 
 SUITE = [
     {"id": "flip", "scene": "torque-free-flip", "engine": "fake", "horizon": 0.2},
@@ -57,7 +57,6 @@ def test_regress_update_pass_and_injected_regression(tmp_path, capsys, monkeypat
     assert "flip: status ok -> diverged" in out and "ball: status ok -> diverged" in out
 
 
-@needs_metrics
 def test_regress_detects_a_metric_outside_its_tolerance(tmp_path, capsys, monkeypatch):
     path = _baseline(tmp_path)
     arguments = ["regress", "--baseline", str(path), *FAKE_OPTION]

@@ -27,7 +27,7 @@ from clearbench.scenarios.inertia import solid_sphere
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.shapes import Sphere
 
-from .harness_helpers import FAKE, needs_metrics
+from .harness_helpers import FAKE
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -213,7 +213,6 @@ def test_work_precision_points_and_figure():
     assert png.startswith(PNG_SIGNATURE)
 
 
-@needs_metrics
 def test_time_series_figure_from_a_fake_run(small_store):
     from clearbench.harness.report.figures import time_series_figure
 

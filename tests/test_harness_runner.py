@@ -66,11 +66,7 @@ def test_every_failure_is_recorded_and_the_rest_of_the_sweep_completes(tmp_path)
     assert not list((store.directory / "trajectories").glob(".*"))
 
 
-def test_energy_growth_is_a_diverged_verdict_when_metrics_are_available(tmp_path):
-    from .harness_helpers import metrics_available
-
-    if not metrics_available:
-        pytest.skip("harness.metrics needs clearbench.scenarios.geometry (not landed yet)")
+def test_energy_growth_is_a_diverged_verdict(tmp_path):
     store = ResultsStore(tmp_path / "store")
     spec = fake_spec("energy", scene="bouncing-ball-e0.5")
     Runner(store, jobs=1).run_all([spec])

@@ -104,3 +104,26 @@ def test_a_failed_transaction_records_nothing(tmp_path):
     except FileNotFoundError:
         pass
     assert len(store) == 0
+
+
+def test_a_runner_removes_the_temporary_files_a_killed_sweep_left(tmp_path):
+    """A sweep killed between saving a run's trajectory and recording it leaves
+    ``.KEY.PID.tmp.npz`` (or its ``.partial.npz``) behind; the next runner on the store removes
+    the ones older than an hour and keeps a fresh one (a run being recorded right now)."""
+    import os
+    import time
+
+    from clearbench.harness.run.runner import Runner
+
+    store = ResultsStore(tmp_path / "store")
+    folder = store.trajectory_dir
+    stale = [folder / ".abc.123.tmp.npz", folder / ".abc.123.tmp.npz.partial.npz"]
+    fresh = folder / ".def.456.tmp.npz"
+    kept = folder / "abc.npz"  # a recorded trajectory is never touched, whatever its age
+    two_hours_ago = time.time() - 7200.0  # beyond the one-hour bound of clean_partial_files
+    for path in (*stale, fresh, kept):
+        path.write_bytes(b"")
+    for path in (*stale, kept):
+        os.utime(path, (two_hours_ago, two_hours_ago))
+    Runner(store, jobs=1)
+    assert sorted(p.name for p in folder.iterdir()) == sorted([fresh.name, kept.name])

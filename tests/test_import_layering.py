@@ -4,9 +4,10 @@ Dependencies point one way: harness -> adapters -> (ref_solver, scenarios) -> th
 floor ``clearbench.kernels``. Checked here: the floor imports nothing else of the project;
 ``ref_solver`` imports only the floor and the scene types (not the scene library, the analytic
 references or the C-60 model); ``scenarios`` imports neither ``ref_solver``, the adapters nor
-the harness; no adapter subpackage imports another; no import cycle among the project's
-modules. Every import counts, at module level or inside a function (``if TYPE_CHECKING:``
-blocks too); imports made by name at run time (``importlib``) do not.
+the harness; the adapters do not import the harness; no adapter subpackage imports another; no
+import cycle among the project's modules. Every import counts, at module level or inside a
+function (``if TYPE_CHECKING:`` blocks too); imports made by name at run time (``importlib``)
+do not.
 """
 
 from __future__ import annotations
@@ -177,6 +178,11 @@ def test_scenarios_import_no_solver_engine_or_harness():
             "clearbench.ref_solver", "clearbench.adapters", "clearbench.harness"))
 
     assert _violations("clearbench.scenarios", allowed) == []
+
+
+def test_adapters_import_no_harness():
+    assert _violations("clearbench.adapters",
+                       lambda target: not _within(target, "clearbench.harness")) == []
 
 
 def _engine_subpackage(module: str) -> str | None:

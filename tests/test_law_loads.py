@@ -87,11 +87,11 @@ def test_an_angle_law_stays_continuous_through_the_cut(engine):
     # Rest angle 2.8 rad from a start at 0: the torsion pendulum swings to 5.6 rad and back,
     # through the cut of the raw angle at pi, where a law on the raw angle would jump by
     # k 2 pi = 12.6 N m and fling the arm.
-    from clearbench.adapters.mujoco import engine as mujoco_engine
+    from clearbench.adapters import mujoco
 
     stiffness, offset = 2.0, 2.8
     scene = lever_pendulum(offset=offset, stiffness=stiffness)
-    runner = ENGINE if engine == "reference" else mujoco_engine.create()
+    runner = ENGINE if engine == "reference" else mujoco.create()
     trajectory = runner.run(scene, RunSettings())
     angle = np.unwrap(metrics.body_angle(trajectory, 1, Z))
     assert angle.max() > 5.5  # it went through pi and near 2 offset

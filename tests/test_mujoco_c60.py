@@ -12,7 +12,7 @@ import pytest
 
 from clearbench.adapters.base import RunSettings, Support
 from clearbench.adapters.mujoco.build import build_model
-from clearbench.adapters.mujoco.engine import _internal_scene, create
+from clearbench.adapters.mujoco.engine import create
 from clearbench.adapters.mujoco.geometry import (
     bore_piece_count,
     bore_radius_error,
@@ -120,7 +120,7 @@ def _perturbed_model(scene, seed: int = 3):
     """The C-60 built in MuJoCo (SI inside), every moving body turned by up to 0.2 rad and
     moved by up to 0.3 mm from the ON pose: a configuration unlike the initial one."""
     settings = resolve_settings("tuned")
-    internal = _internal_scene(scene, settings)
+    internal = create().internal_scene(scene, settings)
     built = build_model(internal, settings, 1e-6)
     model, data = built.model, built.data
     rng = np.random.default_rng(seed)
@@ -169,7 +169,8 @@ def test_the_run_loop_applies_the_law_loads_and_the_moment_every_step():
     scene = get_scene("c60-on")
     settings = resolve_settings("tuned")
     built = _perturbed_model(scene)
-    runner = Runner(_internal_scene(scene, settings), built, settings, steps=1, record_every=1)
+    runner = Runner(create().internal_scene(scene, settings), built, settings, steps=1,
+                    record_every=1)
     mujoco.mj_step1(built.model, built.data)
     runner.apply_loads()
     expected = built.law_forces.wrenches(built.data)

@@ -217,6 +217,7 @@ def test_importing_the_adapter_prints_nothing():
     """PyBullet prints its build time when first imported; the adapter's import drops it (a
     fresh interpreter, since this one has imported pybullet already)."""
     code = ("from clearbench.adapters.pybullet import availability, create; "
+            "from clearbench.adapters.pybullet.library import pb; "
             "assert availability()[0]; create('tuned')")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           timeout=120, check=False)

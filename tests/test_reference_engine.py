@@ -1,7 +1,7 @@
-"""The reference engine against physics: the figures of issue 3's Done-when.
+"""The reference engine against physics.
 
-Every figure comes from the shared evaluator (harness.expectations) and metrics, the same code
-that judges every other engine. Each bound states why it is what it is.
+Every figure comes from the shared evaluator (harness.measure.expectation_figures) and
+metrics, the same code that judges every other engine. Each bound states why it is what it is.
 """
 
 from __future__ import annotations

@@ -37,7 +37,7 @@ import time
 
 import numpy as np
 
-from clearbench.adapters.energy_guard import SPRING_WORK_FEATURES, EnergyGuard
+from clearbench.adapters.energy_guard import EnergyGuard
 from clearbench.adapters.exudyn.build import BuiltSystem, load_exudyn
 from clearbench.adapters.exudyn.failure import failed_loop, failure_reason
 from clearbench.adapters.exudyn.settings import ExudynSettings
@@ -45,6 +45,7 @@ from clearbench.adapters.recording import SampleRecorder
 from clearbench.adapters.trajectory import RunStatus
 from clearbench.kernels.quaternion import quat_from_matrix_batch, quat_to_matrix_batch
 from clearbench.scenarios.bodies import Motion
+from clearbench.scenarios.energy import mechanical_energy, rigid_spring_points
 from clearbench.scenarios.loads import LinearSpringDamper, PointForce
 from clearbench.scenarios.scene import Scene
 
@@ -124,13 +125,12 @@ class Runner:
         self.newton_absolute_tolerance = config.newton_absolute_tolerance
         self.failed_loop = ""
         self.mass = np.array([b.mass for b in scene.bodies])
-        self.inertia = np.array([np.asarray(b.inertia, dtype=float) for b in scene.bodies])
         self.movable = np.array([b.motion is not Motion.FIXED for b in scene.bodies])
         self.gravity = np.asarray(scene.gravity, dtype=float)
         self._springs = [(load, scene.body_index(load.body_a), scene.body_index(load.body_b))
                          for load in scene.loads if isinstance(load, LinearSpringDamper)]
         self.guard = EnergyGuard(scene, config.energy_gain_tolerance, config.guard_interval,
-                                 SPRING_WORK_FEATURES)
+                                 counts_torsional_springs=False)
         self.guard_notes = self.guard.notes
         self._newton_count = 0
         self._last_newton = 0
@@ -157,20 +157,14 @@ class Runner:
         return position, quaternion, rotation, velocity, omega
 
     def energy(self, state=None) -> tuple[float, float]:
-        """(total, kinetic) energy as harness.metrics.energy counts it (model units)."""
+        """(total, kinetic) mechanical energy of ``state`` (default: the current one):
+        :func:`~clearbench.scenarios.energy.mechanical_energy` with linear springs (model
+        units)."""
         position, _, rotation, velocity, omega = state or self.state()
-        m = self.movable
-        kinetic = 0.5 * np.sum(self.mass[m] * np.sum(velocity[m] ** 2, axis=1))
-        kinetic += 0.5 * np.einsum("bi,bij,bj->", omega[m], self.inertia[m], omega[m])
         com = position + np.einsum("bij,bj->bi", rotation, self.built.bodies.com)
-        potential = -np.sum(self.mass[m] * (com[m] @ self.gravity))
-        springs = 0.0
-        for load, a, b in self._springs:
-            pa = position[a] + rotation[a] @ np.asarray(load.point_a)
-            pb = position[b] + rotation[b] @ np.asarray(load.point_b)
-            stretch = np.linalg.norm(pb - pa) - load.rest_length
-            springs += load.preload * stretch + 0.5 * load.stiffness * stretch**2
-        return float(kinetic + potential + springs), float(kinetic)
+        energy = mechanical_energy(self.scene, com, velocity, omega,
+                                   rigid_spring_points(self.scene, position, rotation))
+        return float(energy.total), float(energy.kinetic)
 
     def force_scale(self, state=None) -> float:
         """The scene's force scale [F, model units]: the largest applied force in the current

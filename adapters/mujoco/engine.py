@@ -29,9 +29,8 @@ say energy may only decrease (``energy_non_increasing``, ``energy_conserved``).
 from __future__ import annotations
 
 import logging
-import time
 
-from clearbench.adapters.base import ModuleEngine, RunSettings
+from clearbench.adapters.base import SteppingEngine
 from clearbench.adapters.mujoco import capabilities
 from clearbench.adapters.mujoco.capabilities import (
     bore_summary,
@@ -45,57 +44,71 @@ from clearbench.adapters.mujoco.settings import (
     MujocoSettings,
     resolve_settings,
 )
-from clearbench.adapters.recording import step_count
-from clearbench.adapters.trajectory import RunStatus, Trajectory
+from clearbench.adapters.trajectory import RunStatus
 from clearbench.scenarios.scene import Scene
-from clearbench.scenarios.units import SI
 from clearbench.scenarios.validation import TIME, VELOCITY
 
 logger = logging.getLogger(__name__)
 
-__all__ = ["OPTIONS", "PRESETS", "MujocoEngine", "availability", "create"]
-
-
-def availability() -> tuple[bool, str]:
-    try:
-        import mujoco  # lazy import of the engine package: only when asked about it
-    except ImportError as error:  # pragma: no cover - mujoco is a dependency
-        return False, f"mujoco does not import: {error}"
-    return True, f"mujoco {mujoco.__version__}"
+__all__ = ["OPTIONS", "PRESETS", "MujocoEngine", "create"]
 
 
 def create(preset: str = "default") -> MujocoEngine:
+    """A :class:`MujocoEngine` with ``preset`` (ValueError for an unknown one)."""
     return MujocoEngine(preset)
 
 
-class MujocoEngine(ModuleEngine):
+class MujocoEngine(SteppingEngine):
     """MuJoCo (soft contacts, joint-coordinate trees) with a named preset."""
 
     name = "mujoco"
+    TITLE = "MuJoCo"
     PRESETS = PRESETS
     OPTIONS = OPTIONS
     CAPABILITIES = capabilities
     RESOLVE_SETTINGS = staticmethod(resolve_settings)
 
-    def _run(self, scene: Scene, settings: RunSettings) -> Trajectory:
+    def build(self, internal: Scene, config: MujocoSettings, dt: float):
         # Lazy import of the optional engine package (mujoco) through the model builder.
         from clearbench.adapters.mujoco.build import build_model
 
-        config = self.settings(settings.options)
-        start = time.perf_counter()
-        internal = _internal_scene(scene, config)
+        return build_model(internal, config, dt)
+
+    def runner(self, internal: Scene, built, config: MujocoSettings, steps: int,
+               record_every: int) -> Runner:
+        return Runner(internal, built, config, steps, record_every)
+
+    def step(self, runner: Runner) -> tuple[RunStatus, str]:
+        return _with_logged_warnings(runner)
+
+    def metadata(self, scene: Scene, internal: Scene, config: MujocoSettings, built,
+                 runner: Runner) -> dict:
         to_internal = scene.units.factor_to(internal.units, TIME)
-        dt = (settings.time_step or scene.time_step) * to_internal
-        horizon = (settings.horizon or scene.horizon) * to_internal
-        built = build_model(internal, config, dt)
-        runner = Runner(internal, built, config, step_count(horizon, dt), settings.record_every)
-        build_seconds = time.perf_counter() - start
-        status, message = _with_logged_warnings(runner)
-        return runner.recorder.trajectory(
-            scene, runner.dt, recorded_units=internal.units, engine=self.name,
-            preset=self.preset, build_seconds=build_seconds,
-            stepping_seconds=runner.stepping_seconds, steps=runner.steps_taken, status=status,
-            message=message, metadata=_metadata(scene, internal, config, built, runner))
+        return {
+            "mujoco_version": runner.mujoco.__version__,
+            "settings": config.as_dict(),
+            "units": self.units_note(scene, internal),
+            "time_step_internal": built.model.opt.timestep,
+            "time_step_scene": built.model.opt.timestep / to_internal,
+            "warnings": list(built.warnings) + runner.warnings,
+            "guards": runner.guard_notes,
+            "contact_solref": [list(p.solref) for p in built.contact_parameters],
+            "contact_dampratio": [p.damping_ratio for p in built.contact_parameters],
+            "rings": ring_summary(scene, config),
+            "bores": bore_summary(scene, config),
+            "clearance_joints": clearance_summary(scene, config),
+            "tree": [[link.body, link.parent, link.kind, link.joint]
+                     for link in built.topology.links],
+            "loop_closures": list(built.topology.closures),
+            "initial_velocity_residual": built.initial_velocity_residual
+            * internal.units.factor_to(scene.units, VELOCITY),
+            "mujoco_warnings": runner.mujoco_warnings,
+            "energy_initial": runner.energy_initial,
+            "energy_max_gain": runner.energy_max_gain,
+            "unconverged_steps": runner.unconverged[:1000],
+            "unconverged_count": len(runner.unconverged),
+            "max_contacts": runner.max_contacts,
+        }
 
 
 def _with_logged_warnings(runner) -> tuple[RunStatus, str]:
@@ -114,43 +127,3 @@ def _with_logged_warnings(runner) -> tuple[RunStatus, str]:
         return runner.run()
     finally:
         mujoco.set_mju_user_warning(previous)
-
-
-def _internal_scene(scene: Scene, config: MujocoSettings) -> Scene:
-    if config.internal_units == "SI" and scene.units != SI:
-        return scene.rescaled(SI)
-    return scene
-
-
-def _metadata(scene: Scene, internal: Scene, config: MujocoSettings, built, runner) -> dict:
-    if internal.units != scene.units:
-        units = (f"scene in {scene.units.describe()} rescaled to {internal.units.describe()} "
-                 "for MuJoCo; results converted back")
-    else:
-        units = f"run in the scene's units ({scene.units.describe()})"
-    to_internal = scene.units.factor_to(internal.units, TIME)
-    return {
-        "mujoco_version": runner.mujoco.__version__,
-        "settings": config.as_dict(),
-        "units": units,
-        "time_step_internal": built.model.opt.timestep,
-        "time_step_scene": built.model.opt.timestep / to_internal,
-        "warnings": list(built.warnings) + runner.warnings,
-        "guards": runner.guard_notes,
-        "contact_solref": [list(p.solref) for p in built.contact_parameters],
-        "contact_dampratio": [p.damping_ratio for p in built.contact_parameters],
-        "rings": ring_summary(scene, config),
-        "bores": bore_summary(scene, config),
-        "clearance_joints": clearance_summary(scene, config),
-        "tree": [[link.body, link.parent, link.kind, link.joint]
-                 for link in built.topology.links],
-        "loop_closures": list(built.topology.closures),
-        "initial_velocity_residual": built.initial_velocity_residual
-        * internal.units.factor_to(scene.units, VELOCITY),
-        "mujoco_warnings": runner.mujoco_warnings,
-        "energy_initial": runner.energy_initial,
-        "energy_max_gain": runner.energy_max_gain,
-        "unconverged_steps": runner.unconverged[:1000],
-        "unconverged_count": len(runner.unconverged),
-        "max_contacts": runner.max_contacts,
-    }

@@ -19,7 +19,7 @@ from clearbench.adapters.mujoco.settings import MujocoSettings
 from clearbench.adapters.recording import SampleRecorder
 from clearbench.adapters.trajectory import RunStatus
 from clearbench.kernels.time_profiles import evaluate_profile_slope
-from clearbench.scenarios.bodies import Motion
+from clearbench.scenarios.energy import mechanical_energy
 from clearbench.scenarios.loads import LinearSpringDamper, Moment, PointForce, TorsionalSpringDamper
 from clearbench.scenarios.scene import Scene
 
@@ -44,10 +44,6 @@ class Runner:
         self.recorder = SampleRecorder(len(scene.bodies), len(scene.all_contacts), steps,
                                        record_every)
         self.ids = built.body_ids
-        self.movable = np.array([b.motion is not Motion.FIXED for b in scene.bodies])
-        self.mass = np.array([b.mass for b in scene.bodies])
-        self.inertia = np.array([np.asarray(b.inertia, dtype=float) for b in scene.bodies])
-        self.gravity = np.asarray(scene.gravity, dtype=float)
         self.stepping_seconds = 0.0
         self.steps_taken = 0
         self.unconverged: list[int] = []
@@ -114,27 +110,23 @@ class Runner:
         return d.xpos[ids].copy(), d.xquat[ids].copy(), velocity, omega_body
 
     def energy(self) -> tuple[float, float]:
-        """(total, kinetic) mechanical energy as harness.metrics.energy counts it: kinetic,
-        gravity and spring potential (internal units)."""
+        """(total, kinetic) mechanical energy of the current state
+        (:func:`~clearbench.scenarios.energy.mechanical_energy`: kinetic, gravity, linear and
+        torsional springs; internal units)."""
         d, ids = self.data, self.ids
         _, _, velocity, omega = self.body_state()
-        m = self.movable
-        kinetic = 0.5 * np.sum(self.mass[m] * np.sum(velocity[m] ** 2, axis=1))
-        kinetic += 0.5 * np.einsum("bi,bij,bj->", omega[m], self.inertia[m], omega[m])
-        potential = -np.sum(self.mass[m] * (d.xipos[ids][m] @ self.gravity))
-        springs = 0.0
-        for load, (sa, sb) in zip(self._springs, self._site_ids, strict=True):
-            stretch = np.linalg.norm(d.site_xpos[sb] - d.site_xpos[sa]) - load.rest_length
-            springs += load.preload * stretch + 0.5 * load.stiffness * stretch**2
-        for load, qadr, sign in self._hinge_springs:
-            phi = sign * d.qpos[qadr]
-            springs += load.preload * phi + 0.5 * load.stiffness * (phi - load.rest_angle) ** 2
-        for python_load in self.built.python_loads:
-            load = python_load.load
-            if isinstance(load, TorsionalSpringDamper):
-                phi = python_load.angle
-                springs += load.preload * phi + 0.5 * load.stiffness * (phi - load.rest_angle) ** 2
-        return float(kinetic + potential + springs), float(kinetic)
+        sites = dict(zip((load.name for load in self._springs), self._site_ids, strict=True))
+
+        def spring_points(load):
+            site_a, site_b = sites[load.name]
+            return d.site_xpos[site_a], d.site_xpos[site_b]
+
+        torsion = {load.name: sign * d.qpos[qadr] for load, qadr, sign in self._hinge_springs}
+        torsion.update({item.load.name: item.angle for item in self.built.python_loads
+                        if isinstance(item.load, TorsionalSpringDamper)})
+        energy = mechanical_energy(self.scene, d.xipos[ids], velocity, omega, spring_points,
+                                   torsion)
+        return float(energy.total), float(energy.kinetic)
 
     def check_energy(self) -> str | None:
         return self.guard.check(*self.energy(), self.data.time)

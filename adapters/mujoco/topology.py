@@ -79,10 +79,6 @@ class Topology:
                 return link
         raise KeyError(body)
 
-    @property
-    def tree_joints(self) -> tuple:
-        return tuple(link.joint for link in self.links if link.joint is not None)
-
 
 def plan_topology(scene: Scene) -> Topology:
     """Split the joint graph of ``scene`` into a MuJoCo tree and loop closures."""

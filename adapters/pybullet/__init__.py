@@ -1,6 +1,14 @@
-"""Prototype of the PyBullet engine adapter (issue 14): ``create(preset)`` and
-``availability()`` as every adapter module exposes them."""
+"""The PyBullet engine: a scene rebuilt in PyBullet (rigid bodies and Featherstone trees),
+stepped with guards, read out."""
 
-from clearbench.adapters.pybullet.engine import PRESETS, PybulletEngine, availability, create
+from clearbench.adapters import installed_package, lazy_engine
 
-__all__ = ["PRESETS", "PybulletEngine", "availability", "create"]
+__all__ = ["PybulletEngine", "PRESETS", "availability", "create"]
+
+create, __getattr__ = lazy_engine(__name__, "PybulletEngine", "PRESETS")
+
+
+def availability() -> tuple[bool, str]:
+    """(True, version) when the ``pybullet`` package is installed, else (False, why); never
+    raises, imports nothing."""
+    return installed_package("pybullet")

@@ -17,10 +17,8 @@ the results are converted back; the metadata records the internal units.
 
 from __future__ import annotations
 
-import time
-from importlib.metadata import PackageNotFoundError, version
-
-from clearbench.adapters.base import ModuleEngine, RunSettings
+from clearbench.adapters import installed_package
+from clearbench.adapters.base import SteppingEngine
 from clearbench.adapters.pybullet import capabilities
 from clearbench.adapters.pybullet.capabilities import ring_summary
 from clearbench.adapters.pybullet.geometry import margin_feature_length
@@ -30,40 +28,27 @@ from clearbench.adapters.pybullet.settings import (
     PybulletSettings,
     resolve_settings,
 )
-from clearbench.adapters.recording import step_count
-from clearbench.adapters.trajectory import Trajectory
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.units import MM_G_MS, SI, UnitSystem
 from clearbench.scenarios.validation import LENGTH, TIME, VELOCITY
 
-__all__ = ["AUTO_MILLIMETRE_BELOW", "OPTIONS", "PRESETS", "PybulletEngine",
-           "availability", "create", "internal_units"]
+__all__ = ["AUTO_MILLIMETRE_BELOW", "OPTIONS", "PRESETS", "PybulletEngine", "create",
+           "internal_units"]
 
 #: Below this smallest feature [m], ``internal_units = 'auto'`` models in mm-g-ms instead of SI.
 AUTO_MILLIMETRE_BELOW = 1e-3
 
 
-def availability() -> tuple[bool, str]:
-    """(available, detail) of the pybullet package; never raises."""
-    try:
-        # lazy import of the engine package (only when asked), without its build-time banner
-        from clearbench.adapters.pybullet.library import pb  # noqa: F401
-    except ImportError as error:  # pragma: no cover - pybullet is a dependency
-        return False, f"pybullet does not import: {error}"
-    try:
-        return True, f"pybullet {version('pybullet')}"
-    except PackageNotFoundError:  # pragma: no cover - a source build without metadata
-        return True, "pybullet (version unknown)"
-
-
 def create(preset: str = "default") -> PybulletEngine:
+    """A :class:`PybulletEngine` with ``preset`` (ValueError for an unknown one)."""
     return PybulletEngine(preset)
 
 
-class PybulletEngine(ModuleEngine):
+class PybulletEngine(SteppingEngine):
     """PyBullet (velocity-level sequential impulses, Featherstone trees) with a named preset."""
 
     name = "pybullet"
+    TITLE = "PyBullet"
     PRESETS = PRESETS
     OPTIONS = OPTIONS
     CAPABILITIES = capabilities
@@ -72,29 +57,55 @@ class PybulletEngine(ModuleEngine):
     def capability_scene(self, scene: Scene, settings: PybulletSettings) -> Scene:
         return internal_scene(scene, settings)
 
-    def _run(self, scene: Scene, settings: RunSettings) -> Trajectory:
+    def internal_scene(self, scene: Scene, config: PybulletSettings) -> Scene:
+        return internal_scene(scene, config)
+
+    def build(self, internal: Scene, config: PybulletSettings, dt: float):
         # Lazy import of the engine package (pybullet) through the world builder and the loop.
-        from clearbench.adapters.pybullet.build import build_world, disconnect
+        from clearbench.adapters.pybullet.build import build_world
+
+        return build_world(internal, config, dt)
+
+    def runner(self, internal: Scene, built, config: PybulletSettings, steps: int,
+               record_every: int):
         from clearbench.adapters.pybullet.run import Runner
 
-        config = self.settings(settings.options)
-        start = time.perf_counter()
-        internal = internal_scene(scene, config)
+        return Runner(built, steps, record_every)
+
+    def release(self, built) -> None:
+        from clearbench.adapters.pybullet.build import disconnect
+
+        disconnect(built)
+
+    def metadata(self, scene: Scene, internal: Scene, config: PybulletSettings, built,
+                 runner) -> dict:
         to_internal = scene.units.factor_to(internal.units, TIME)
-        dt = (settings.time_step or scene.time_step) * to_internal
-        horizon = (settings.horizon or scene.horizon) * to_internal
-        built = build_world(internal, config, dt)
-        try:
-            runner = Runner(built, step_count(horizon, dt), settings.record_every)
-            build_seconds = time.perf_counter() - start
-            status, message = runner.run()
-        finally:
-            disconnect(built)
-        return runner.recorder.trajectory(
-            scene, dt, recorded_units=internal.units, engine=self.name, preset=self.preset,
-            build_seconds=build_seconds, stepping_seconds=runner.stepping_seconds,
-            steps=runner.steps_taken, status=status, message=message,
-            metadata=_metadata(scene, internal, config, built, runner))
+        topology = built.topology
+        return {
+            "pybullet_version": installed_package("pybullet")[1],
+            "settings": config.as_dict(),
+            "units": self.units_note(scene, internal),
+            "internal_units": internal.units.describe(),
+            "time_step_internal": built.time_step,
+            "time_step_scene": built.time_step / to_internal,
+            "collision_margin_internal": built.margin,
+            "contact_breaking_threshold_set": config.contact_breaking_threshold,
+            "warnings": list(built.warnings),
+            "guards": runner.guard.notes,
+            "static_bodies": list(topology.static),
+            "rigid_bodies": list(topology.rigid),
+            "multibodies": [[link.body for link in tree.links] for tree in topology.trees],
+            "loop_closures": list(topology.closures),
+            "collision_objects": len(built.objects),
+            "rings": ring_summary(internal, config),
+            "initial_velocity_residual": built.initial_velocity_residual
+            * internal.units.factor_to(scene.units, VELOCITY),
+            "energy_initial": runner.guard.energy_initial,
+            "energy_max_gain": runner.guard.max_gain,
+            "unconverged_steps": runner.unconverged[:1000],
+            "unconverged_count": len(runner.unconverged),
+            "max_contacts": runner.max_contacts,
+        }
 
 
 def internal_units(scene: Scene, config: PybulletSettings) -> UnitSystem:
@@ -118,38 +129,3 @@ def internal_scene(scene: Scene, config: PybulletSettings) -> Scene:
     """``scene`` in :func:`internal_units`."""
     units = internal_units(scene, config)
     return scene if units == scene.units else scene.rescaled(units)
-
-
-def _metadata(scene: Scene, internal: Scene, config: PybulletSettings, built, runner) -> dict:
-    if internal.units != scene.units:
-        units = (f"scene in {scene.units.describe()} rescaled to {internal.units.describe()} "
-                 "for PyBullet; results converted back")
-    else:
-        units = f"run in the scene's units ({scene.units.describe()})"
-    to_internal = scene.units.factor_to(internal.units, TIME)
-    topology = built.topology
-    return {
-        "pybullet_version": availability()[1],
-        "settings": config.as_dict(),
-        "units": units,
-        "internal_units": internal.units.describe(),
-        "time_step_internal": built.time_step,
-        "time_step_scene": built.time_step / to_internal,
-        "collision_margin_internal": built.margin,
-        "contact_breaking_threshold_set": config.contact_breaking_threshold,
-        "warnings": list(built.warnings),
-        "guards": runner.guard.notes,
-        "static_bodies": list(topology.static),
-        "rigid_bodies": list(topology.rigid),
-        "multibodies": [[link.body for link in tree.links] for tree in topology.trees],
-        "loop_closures": list(topology.closures),
-        "collision_objects": len(built.objects),
-        "rings": ring_summary(internal, config),
-        "initial_velocity_residual": built.initial_velocity_residual
-        * internal.units.factor_to(scene.units, VELOCITY),
-        "energy_initial": runner.guard.energy_initial,
-        "energy_max_gain": runner.guard.max_gain,
-        "unconverged_steps": runner.unconverged[:1000],
-        "unconverged_count": len(runner.unconverged),
-        "max_contacts": runner.max_contacts,
-    }

@@ -26,7 +26,7 @@ import time
 
 import numpy as np
 
-from clearbench.adapters.energy_guard import SPRING_WORK_FEATURES, EnergyGuard
+from clearbench.adapters.energy_guard import EnergyGuard
 from clearbench.adapters.pybullet.frames import from_pb
 from clearbench.adapters.pybullet.library import pb
 from clearbench.adapters.pybullet.world import BuiltWorld
@@ -34,7 +34,7 @@ from clearbench.adapters.recording import SampleRecorder
 from clearbench.adapters.trajectory import RunStatus
 from clearbench.kernels.quaternion import quat_conjugate, quat_multiply, quat_to_matrix
 from clearbench.scenarios.bodies import Motion
-from clearbench.scenarios.loads import LinearSpringDamper
+from clearbench.scenarios.energy import mechanical_energy, rigid_spring_points
 
 logger = logging.getLogger(__name__)
 
@@ -50,18 +50,13 @@ class Runner:
         self.dt = built.time_step
         self.recorder = SampleRecorder(len(scene.bodies), len(scene.all_contacts), steps,
                                        record_every)
-        self.movable = np.array([b.motion is not Motion.FIXED for b in scene.bodies])
-        self.mass = np.array([b.mass for b in scene.bodies])
-        self.inertia = np.array([np.asarray(b.inertia, dtype=float) for b in scene.bodies])
-        self.gravity = np.asarray(scene.gravity, dtype=float)
         self.time = 0.0
         self.stepping_seconds = 0.0
         self.steps_taken = 0
         self.unconverged: list[int] = []
         self.max_contacts = 0
-        self._springs = [load for load in scene.loads if isinstance(load, LinearSpringDamper)]
         self.guard = EnergyGuard(scene, self.config.energy_gain_tolerance,
-                                 self.config.guard_interval, SPRING_WORK_FEATURES)
+                                 self.config.guard_interval, counts_torsional_springs=False)
         # Static bodies never move: their poses are the scene's.
         self._static_pose = {i: (np.asarray(b.position, float),
                                  np.asarray(b.orientation, float) / np.linalg.norm(
@@ -140,21 +135,13 @@ class Runner:
 
     # ------------------------------------------------------------------ guards
     def energy(self, state) -> tuple[float, float]:
-        """(total, kinetic) mechanical energy: kinetic, gravity and linear-spring potential."""
+        """(total, kinetic) mechanical energy of ``state`` (:meth:`state`):
+        :func:`~clearbench.scenarios.energy.mechanical_energy` with linear springs (internal
+        units)."""
         position, _, velocity, omega, com, rotation = state
-        m = self.movable
-        kinetic = 0.5 * np.sum(self.mass[m] * np.sum(velocity[m] ** 2, axis=1))
-        kinetic += 0.5 * np.einsum("bi,bij,bj->", omega[m], self.inertia[m], omega[m])
-        potential = -np.sum(self.mass[m] * (com[m] @ self.gravity))
-        springs = 0.0
-        index = {b.name: i for i, b in enumerate(self.scene.bodies)}
-        for load in self._springs:
-            a, b = index[load.body_a], index[load.body_b]
-            pa = position[a] + rotation[a] @ np.asarray(load.point_a, float)
-            pb_ = position[b] + rotation[b] @ np.asarray(load.point_b, float)
-            stretch = np.linalg.norm(pb_ - pa) - load.rest_length
-            springs += load.preload * stretch + 0.5 * load.stiffness * stretch**2
-        return float(kinetic + potential + springs), float(kinetic)
+        energy = mechanical_energy(self.scene, com, velocity, omega,
+                                   rigid_spring_points(self.scene, position, rotation))
+        return float(energy.total), float(energy.kinetic)
 
     def check_energy(self, state) -> str | None:
         return self.guard.check(*self.energy(state), self.time)

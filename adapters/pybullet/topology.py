@@ -83,13 +83,6 @@ class Topology:
     problems: tuple
     ignored_joints: tuple = ()
 
-    def tree_of(self, body: str) -> tuple[int, LinkPlan] | None:
-        for index, tree in enumerate(self.trees):
-            for link in tree.links:
-                if link.body == body:
-                    return index, link
-        return None
-
 
 def plan_topology(scene: Scene, body_model: str, collision_objects: dict[str, int]
                   ) -> Topology:

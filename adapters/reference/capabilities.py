@@ -1,6 +1,8 @@
 """What the reference engine does with each scene feature: every feature it knows is exact
 (nonsmooth) and native; a contact pair is native where the shared geometry has a closed-form gap
-for it (:mod:`clearbench.scenarios.geometry`). A feature not listed here is unknown to it."""
+for it (:mod:`clearbench.scenarios.geometry`). A feature not listed here is unknown to it. The
+functions take the context of :class:`~clearbench.adapters.base.ModuleEngine` first (unused:
+the answers depend on neither the scene's values nor the options)."""
 
 from __future__ import annotations
 
@@ -19,22 +21,22 @@ NATIVE_FEATURES = (
 )
 
 
-def plain_capability(name: str) -> Capability | None:
+def plain_capability(context, name: str) -> Capability | None:
     """Native for :data:`NATIVE_FEATURES`, else unknown (None)."""
     return Capability(Support.NATIVE, EXACT) if name in NATIVE_FEATURES else None
 
 
-def shape_capability(kind: str) -> Capability | None:
+def shape_capability(context, kind: str) -> Capability | None:
     """Native for every shape kind of the shared geometry, else unknown (None)."""
     return Capability(Support.NATIVE, EXACT) if kind in SHAPE_CODES else None
 
 
-def joint_capability(kind: str) -> Capability | None:
+def joint_capability(context, kind: str) -> Capability | None:
     """Native for every ideal joint kind of the solver, else unknown (None)."""
     return Capability(Support.NATIVE, EXACT) if kind in JOINT_CODES else None
 
 
-def pair_capability(kind_a: str, kind_b: str) -> Capability | None:
+def pair_capability(context, kind_a: str, kind_b: str) -> Capability | None:
     """Native where the shared geometry has a gap function for the pair, unsupported where it
     has none; unknown (None) for a shape kind it does not know."""
     if kind_a not in SHAPE_CODES or kind_b not in SHAPE_CODES:

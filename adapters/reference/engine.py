@@ -15,13 +15,17 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-import clearbench
-from clearbench.adapters.base import Capability, Engine, RunSettings
+from clearbench.adapters.base import ModuleEngine, RunSettings
 from clearbench.adapters.options import OptionError
 from clearbench.adapters.recording import SampleRecorder, step_count
 from clearbench.adapters.reference import capabilities
 from clearbench.adapters.reference.build import build
-from clearbench.adapters.reference.settings import OPTIONS, PRESETS, stepper_settings
+from clearbench.adapters.reference.settings import (
+    OPTIONS,
+    PRESETS,
+    resolve_settings,
+    stepper_settings,
+)
 from clearbench.adapters.reference.step_loop import choose_step_loop, run_compiled
 from clearbench.adapters.trajectory import RunStatus, Trajectory
 from clearbench.kernels.quaternion import quat_rotate_batch
@@ -29,36 +33,23 @@ from clearbench.ref_solver.stepper import StepperSettings
 from clearbench.ref_solver.system import State
 from clearbench.scenarios.scene import Scene
 
-__all__ = ["OPTIONS", "PRESETS", "ReferenceEngine", "availability", "create"]
-
-
-def availability() -> tuple[bool, str]:
-    return True, f"built in (clearbench {clearbench.__version__})"
+__all__ = ["OPTIONS", "PRESETS", "ReferenceEngine", "create"]
 
 
 def create(preset: str = "default") -> ReferenceEngine:
+    """A :class:`ReferenceEngine` with ``preset`` (ValueError for an unknown one)."""
     return ReferenceEngine(preset)
 
 
-class ReferenceEngine(Engine):
+class ReferenceEngine(ModuleEngine):
     """Our nonsmooth reference solver (see :mod:`clearbench.ref_solver.stepper`)."""
 
     name = "reference"
     RIGID_CONTACTS = True
     PRESETS = PRESETS
     OPTIONS = OPTIONS
-
-    def plain_capability(self, context, name: str) -> Capability | None:
-        return capabilities.plain_capability(name)
-
-    def shape_capability(self, context, kind: str) -> Capability | None:
-        return capabilities.shape_capability(kind)
-
-    def joint_capability(self, context, kind: str) -> Capability | None:
-        return capabilities.joint_capability(kind)
-
-    def pair_capability(self, context, kind_a: str, kind_b: str) -> Capability | None:
-        return capabilities.pair_capability(kind_a, kind_b)
+    CAPABILITIES = capabilities
+    RESOLVE_SETTINGS = staticmethod(resolve_settings)
 
     def check_option_combination(self, options: Mapping) -> None:
         # An explicit localise_impacts = true needs the projection (without it, the preset's

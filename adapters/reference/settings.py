@@ -23,6 +23,8 @@ which takes the bouncing-ball apex errors at h = 1e-3 s from 8e-3 to 2e-5),
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 
 from clearbench.adapters.base import RunSettings
@@ -99,3 +101,9 @@ def stepper_settings(preset: str, scene: Scene, settings: RunSettings) -> Steppe
             2.0 * float(np.linalg.norm(scene.gravity)) * (settings.time_step
                                                            or scene.time_step))),
     )
+
+
+def resolve_settings(preset: str, options: Mapping | None = None) -> dict:
+    """The preset overridden by ``options`` (checked by the engine against :data:`OPTIONS`),
+    before the scene is known: what the capability functions are given."""
+    return {**PRESETS[preset], **(options or {})}

@@ -68,10 +68,6 @@ class TripEvents:
     chatter: int
     gap_after: float
 
-    @property
-    def opening_after_strike(self) -> float:
-        return self.opening - self.strike
-
 
 def _first(mask: np.ndarray, times: np.ndarray, after: float) -> float:
     hits = np.nonzero(mask & (times > after))[0]

@@ -1,4 +1,4 @@
-"""Which model did the paper run? The C-60 identification study (issue 18).
+"""Which model did the paper run? The C-60 identification study.
 
 Every figure the paper publishes, computed for the source's documented alternatives and their
 combinations (:data:`clearbench.scenarios.c60.variants.VARIANTS`) with the reference engine:

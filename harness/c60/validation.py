@@ -353,10 +353,10 @@ MODEL_NOTES = (
     "(0, 0, 5) in the body frame lies 5 mm off its axis in both the source and the paper.",
     "Joint J1's top ring has 0.041 mm radial clearance with the sheet's offsets (0.52 mm CAD "
     "gap), twice the other joints' 0.021 mm; the needle's S3 bearings 0.006 mm.",
-    "Plane faces reach 0.5 mm behind their surface (c60_model.FACE_DEPTH): after the trip "
-    "the handle turns freely (the source has no OFF stop) and brings its ON-stop face round "
-    "behind the case's stop pins; without a depth that counted as an 8.5 mm penetration at "
-    "15.2 ms and the projection tore the handle out of its bearing.",
+    "Plane faces reach 0.5 mm behind their surface (scenarios.c60.model.FACE_DEPTH): after "
+    "the trip the handle turns freely (the source has no OFF stop) and brings its ON-stop "
+    "face round behind the case's stop pins; without a depth that counted as an 8.5 mm "
+    "penetration at 15.2 ms and the projection tore the handle out of its bearing.",
     "Angle laws take each body's angle about the law's axis as the source's 2 acos(q_w) "
     "does, but continuous: a body turning through the cut of the raw angle (pi) keeps its law "
     "continuous (the source's would jump by k 2 pi; in the ON and trip runs no law body comes "

@@ -27,6 +27,7 @@ from clearbench.harness.c60.angles import body_angles
 from clearbench.harness.c60.cross_engine import collect
 from clearbench.harness.c60.validation import validate, write_figures, write_json, write_markdown
 from clearbench.harness.c60.work_precision import steps_for_target, work_precision
+from clearbench.harness.cli.commands import command_help
 from clearbench.harness.cli.common import (
     UserError,
     add_engine_option,
@@ -48,7 +49,7 @@ DEFAULT_IDENTIFICATION = Path("reports/c60_identification.md")
 
 def register(subparsers) -> None:
     parser = subparsers.add_parser(
-        "c60", help="C-60 circuit breaker: validation against the published figures",
+        "c60", help=command_help("c60"),
         description="C-60 circuit-breaker tools. `clearbench c60 validate` runs the C-60 "
         "scenes with the reference engine and compares FC-1, the functional conditions, the "
         "trip and the bench tests of Section 5 with the paper's figures; `clearbench c60 "

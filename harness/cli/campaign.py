@@ -17,6 +17,7 @@ import os
 import sys
 from pathlib import Path
 
+from clearbench.harness.cli.commands import command_help
 from clearbench.harness.cli.common import (
     UserError,
     add_engine_option,
@@ -46,8 +47,7 @@ DEFAULT_OUT = "reports/campaigns"
 def register(subparsers) -> None:
     """Add the ``campaign`` command and its sub-commands."""
     parser = subparsers.add_parser(
-        "campaign", help="tolerance studies: Monte Carlo / quasi-Monte Carlo over scene "
-        "parameters, resumable, on Dask",
+        "campaign", help=command_help("campaign"),
         description="A tolerance campaign draws scene parameters (e.g. the C-60's joint "
         "clearances) from their laws, runs one isolated run per sample into the results "
         "store, and summarises the outputs with capability indices. Shipped campaigns: "

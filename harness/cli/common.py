@@ -1,6 +1,7 @@
-"""What the sub-commands share: :class:`UserError`, the ``-e`` engine option of every command
-(:func:`add_engine_option`), the options of the commands that run engines (store, parallelism,
-limits, plugins) and their progress line (:func:`progress_line`).
+"""What the sub-commands share: :class:`~clearbench.harness.cli.errors.UserError` (imported
+here for them), the ``-e`` engine option of every command (:func:`add_engine_option`), the
+options of the commands that run engines (store, parallelism, limits, plugins) and their
+progress line (:func:`progress_line`).
 
 Bad input is reported by :func:`clearbench.harness.cli.main.main` as one line on stderr with
 exit status 2: a command raises :class:`UserError` for a bad option of its own, and lets the
@@ -15,17 +16,13 @@ import os
 import sys
 from pathlib import Path
 
+from clearbench.harness.cli.errors import UserError
 from clearbench.harness.measure.headline import format_value
 from clearbench.harness.measure.verdicts import run_verdict, verdict_text
 from clearbench.harness.run.runner import Runner, default_jobs
 from clearbench.harness.run.spec import DEFAULT_TIMEOUT, RunSpec, parse_assignment
 from clearbench.harness.run.store import ResultsStore, RunRecord
 from clearbench.scenarios.units import TIME_UNITS
-
-
-class UserError(Exception):
-    """Bad input from the user: printed as one line on stderr, exit status 2."""
-
 
 #: Store used when --store is not given (overridden by the CLEARBENCH_STORE variable).
 DEFAULT_STORE = "reports/store"

@@ -6,6 +6,7 @@ import argparse
 import time
 
 from clearbench.harness.cli.c60 import run_c60_plan
+from clearbench.harness.cli.commands import command_help
 from clearbench.harness.cli.common import (
     UserError,
     add_engine_option,
@@ -14,6 +15,7 @@ from clearbench.harness.cli.common import (
     make_runner,
     open_store,
 )
+from clearbench.harness.cli.scenes import check_round_trip, print_engines
 from clearbench.harness.cli.sweep import print_work_precision
 from clearbench.harness.report.page import write_report
 from clearbench.harness.run.engine_choice import RunInputError, resolve_engine
@@ -26,7 +28,7 @@ from clearbench.harness.studies.sweep import (
     parse_ladder,
     plan_sweep,
 )
-from clearbench.scenarios.library import scene_names
+from clearbench.scenarios.library import get_entry, scene_names
 
 #: Scenes of the default comparison: the library scenes with these tags.
 COMPARE_TAGS = ("smoke", "analytic")
@@ -44,8 +46,17 @@ def compare_scenes() -> list[str]:
 
 
 def register(subparsers) -> None:
+    """Add ``demo`` and ``compare`` to ``subparsers``."""
+    demo = subparsers.add_parser(
+        "demo", help=command_help("demo"),
+        description="The main job: validate every registered scene, list the engines, then run "
+        "the default comparison of the available engines (`clearbench compare`) and write the "
+        "report. Takes the options of `compare`.",
+    )
+    add_compare_options(demo)
+    demo.set_defaults(handler=run_demo)
     parser = subparsers.add_parser(
-        "compare", help="the default comparison of the available engines, and its report",
+        "compare", help=command_help("compare"),
         description="Run the default comparison: every available engine (reference, and "
         "MuJoCo etc. where available) on the library scenes tagged "
         f"{' or '.join(COMPARE_TAGS)} at their comfortable step and a short ladder "
@@ -54,6 +65,20 @@ def register(subparsers) -> None:
     )
     add_compare_options(parser)
     parser.set_defaults(handler=run_compare)
+
+
+def run_demo(args: argparse.Namespace) -> int:
+    """Validate every registered scene, list the engines, then :func:`run_compare`."""
+    print("Validating every registered scene (build, lossless round trip):")
+    for name in scene_names():
+        scene = get_entry(name).build()
+        check_round_trip(scene, f"scene {name!r}")
+        print(f"  ok  {name:<22} {len(scene.bodies)} bodies, {len(scene.all_contacts)} "
+              f"contact pairs, horizon {scene.horizon} {scene.units.time}")
+    print()
+    print_engines()
+    print()
+    return run_compare(args)
 
 
 def add_compare_options(parser: argparse.ArgumentParser) -> None:

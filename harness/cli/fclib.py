@@ -7,6 +7,7 @@ import math
 from pathlib import Path
 
 from clearbench.adapters.siconos.process import siconos_availability
+from clearbench.harness.cli.commands import command_help
 from clearbench.harness.cli.common import UserError
 from clearbench.harness.fclib.compare import (
     ALL_SOLVERS,
@@ -28,7 +29,7 @@ def register(subparsers) -> None:
     """Add the ``fclib`` sub-command."""
     parser = subparsers.add_parser(
         "fclib",
-        help="validate the contact solvers on FCLIB problems (side by side with Siconos)",
+        help=command_help("fclib"),
         description=(
             "Solve FCLIB / Siconos frictional contact problems with our solvers and, when "
             "Debian's python3-siconos is installed, with Siconos NSGS-AC and NSN-AC. Every "

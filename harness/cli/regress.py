@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import time
 
+from clearbench.harness.cli.commands import command_help
 from clearbench.harness.cli.common import UserError, engine_modules
 from clearbench.harness.run.engine_choice import RunInputError
 from clearbench.harness.studies.regress import (
@@ -23,7 +24,7 @@ from clearbench.harness.studies.regress.suite import warm_up
 
 def register(subparsers) -> None:
     parser = subparsers.add_parser(
-        "regress", help="compare a quick suite with the committed baseline",
+        "regress", help=command_help("regress"),
         description="Run the quick suite of the baseline file (every available engine on a "
         "few smoke scenes with short horizons, and a short c60-on each) in a fresh temporary "
         "store and compare status, expectations and every figure with the baseline, each "

@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import argparse
 
+from clearbench.harness.cli.commands import command_help
 from clearbench.harness.cli.common import add_store_option, open_store
 from clearbench.harness.report.page import C60_VALIDATION, write_report
 
 
 def register(subparsers) -> None:
     parser = subparsers.add_parser(
-        "report", help="write the HTML report and Markdown summary from a results store",
+        "report", help=command_help("report"),
         description="Read a results store and write a self-contained HTML page (figures "
         "embedded) and a Markdown summary: overview matrix scene x engine, the stiff suite, "
         "per scene a metrics table, work–precision plot and drift over time, and the "

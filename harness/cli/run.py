@@ -6,6 +6,7 @@ import argparse
 import json
 import shutil
 
+from clearbench.harness.cli.commands import command_help
 from clearbench.harness.cli.common import (
     UserError,
     add_engine_option,
@@ -25,7 +26,7 @@ from clearbench.scenarios.units import UnitSystem
 
 def register(subparsers) -> None:
     parser = subparsers.add_parser(
-        "run", help="run one scene in one engine and print its metrics",
+        "run", help=command_help("run"),
         description="Run SCENE (a registered name or a .toml/.json scene file) in one engine, in "
         "an isolated worker process with a wall-clock limit, record it in the results store "
         "and print its metrics, expectations and verdict. A run already in the store is shown "

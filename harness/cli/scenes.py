@@ -1,4 +1,4 @@
-"""Scene sub-commands: ``list``, ``show``, ``validate`` and ``demo``."""
+"""Scene sub-commands: ``list``, ``show`` and ``validate``."""
 
 from __future__ import annotations
 
@@ -7,9 +7,10 @@ import sys
 import textwrap
 
 from clearbench.adapters import all_availability
-from clearbench.harness.cli.common import UserError
-from clearbench.harness.cli.compare import add_compare_options, run_compare
+from clearbench.harness.cli.commands import command_help
+from clearbench.harness.cli.errors import UserError
 from clearbench.scenarios.library import SCENES, get_entry, scene_names
+from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.serialization import (
     load_scene_file,
     scene_from_dict,
@@ -24,7 +25,7 @@ from clearbench.scenarios.validation import SceneError
 def register(subparsers) -> None:
     """Add the scene sub-commands to ``subparsers``."""
     listing = subparsers.add_parser(
-        "list", help="list the registered scenes (tags, features) and the engines",
+        "list", help=command_help("list"),
         description="List every registered scene with its tags and derived features, and every "
         "engine with its availability on this machine.",
     )
@@ -32,7 +33,7 @@ def register(subparsers) -> None:
     listing.set_defaults(handler=run_list)
 
     show = subparsers.add_parser(
-        "show", help="print a scene in TOML or JSON",
+        "show", help=command_help("show"),
         description="Print a registered scene as a TOML (default) or JSON scene file.",
     )
     show.add_argument("scene", help="registered scene name (see `clearbench list`)")
@@ -42,22 +43,13 @@ def register(subparsers) -> None:
     show.set_defaults(handler=run_show)
 
     validate = subparsers.add_parser(
-        "validate", help="validate a scene file (TOML or JSON)",
+        "validate", help=command_help("validate"),
         description="Read a scene file, validate every field and cross reference, and check "
         "that it round-trips losslessly. Exit status 0 when valid, 2 with the field and value "
         "at fault otherwise.",
     )
     validate.add_argument("file", help="scene file (.toml or .json)")
     validate.set_defaults(handler=run_validate)
-
-    demo = subparsers.add_parser(
-        "demo", help="the README's main job: validate the scenes, run the comparison, report",
-        description="The main job: validate every registered scene, list the engines, then run "
-        "the default comparison of the available engines (`clearbench compare`) and write the "
-        "report. Takes the options of `compare`.",
-    )
-    add_compare_options(demo)
-    demo.set_defaults(handler=run_demo)
 
 
 def parse_units(text: str) -> UnitSystem:
@@ -88,11 +80,23 @@ def run_list(args: argparse.Namespace) -> int:
         features = ", ".join(sorted(scene.features)) or "(none)"
         for line in textwrap.wrap(f"features: {features}", 74):
             print(f"  {'':<22} {line}")
-    print("\nEngines:")
+    print()
+    print_engines()
+    return 0
+
+
+def check_round_trip(scene: Scene, where: str) -> None:
+    """UserError naming ``where`` when ``scene`` does not come back equal from its dict form."""
+    if scene_from_dict(scene_to_dict(scene)) != scene:
+        raise UserError(f"{where}: the scene does not round-trip losslessly (a bug)")
+
+
+def print_engines() -> None:
+    """Print every engine of the registry with its availability here."""
+    print("Engines:")
     for availability in all_availability():
         state = "available" if availability.available else "unavailable"
         print(f"  {availability.engine:<10} {state:<12} {availability.detail}")
-    return 0
 
 
 def run_show(args: argparse.Namespace) -> int:
@@ -115,27 +119,10 @@ def run_validate(args: argparse.Namespace) -> int:
         raise UserError(f"{args.file}: no such file") from None
     except SceneError as error:
         raise UserError(f"{args.file}: invalid scene: {error}") from None
-    again = scene_from_dict(scene_to_dict(scene))
-    if again != scene:
-        raise UserError(f"{args.file}: the scene does not round-trip losslessly (a bug)")
+    check_round_trip(scene, args.file)
     print(f"{args.file}: valid scene {scene.name!r} in {scene.units.describe()}: "
           f"{len(scene.bodies)} bodies, {len(scene.joints)} joints, "
           f"{len(scene.clearance_joints)} clearance joints, {len(scene.all_contacts)} contact "
           f"pairs, horizon {scene.horizon} {scene.units.time}")
     print(f"  features: {', '.join(sorted(scene.features)) or '(none)'}")
     return 0
-
-
-def run_demo(args: argparse.Namespace) -> int:
-    print("Validating every registered scene (build, lossless round trip, mm-g-ms rescale):")
-    for name in scene_names():
-        scene = get_entry(name).build()
-        assert scene_from_dict(scene_to_dict(scene)) == scene
-        print(f"  ok  {name:<22} {len(scene.bodies)} bodies, {len(scene.all_contacts)} "
-              f"contact pairs, horizon {scene.horizon} {scene.units.time}")
-    print("\nEngines:")
-    for availability in all_availability():
-        state = "available" if availability.available else "unavailable"
-        print(f"  {availability.engine:<10} {state:<12} {availability.detail}")
-    print()
-    return run_compare(args)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from clearbench.harness.cli.commands import command_help
 from clearbench.harness.cli.common import (
     UserError,
     add_engine_option,
@@ -26,7 +27,7 @@ from clearbench.harness.studies.sweep import resolve_engines
 
 def register(subparsers) -> None:
     parser = subparsers.add_parser(
-        "stability", help="the stiff and extreme suite: verdict and metrics per engine",
+        "stability", help=command_help("stability"),
         description="Run every scene tagged 'stiff' (tight clearances, mass ratio 1e4, stiff "
         "springs, 10x steps, tunnelling impacts, mu = 2, e = 1, 100+ contacts, millimetre parts "
         "in SI units) in each engine at the case's own step, and print each engine's verdict "

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from clearbench.harness.cli.commands import command_help
 from clearbench.harness.cli.common import (
     UserError,
     add_engine_option,
@@ -30,7 +31,7 @@ from clearbench.scenarios.library import scene_names
 
 def register(subparsers) -> None:
     parser = subparsers.add_parser(
-        "sweep", help="work–precision sweep: error against stepping time over a ladder of steps",
+        "sweep", help=command_help("sweep"),
         description="Run every SCENE in every engine at every time step of the ladder (each run "
         "isolated, in parallel, stored; runs already in the store are not run again, so an "
         "interrupted sweep resumes), then print per scene the work–precision points (error "

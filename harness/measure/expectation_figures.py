@@ -35,10 +35,6 @@ class ExpectationResult:
     note: str = ""
     where: str = ""
 
-    @property
-    def headline_value(self) -> float:
-        return float(self.figures.get(self.headline, math.nan))
-
 
 def evaluate(scene: Scene, trajectory: Trajectory) -> list[ExpectationResult]:
     """Figures of every expectation of ``scene`` on ``trajectory`` (empty trajectories give

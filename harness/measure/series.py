@@ -9,7 +9,7 @@ judged against (:func:`shape_size`, :func:`body_size`, :func:`energy_scale`) are
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -22,6 +22,7 @@ from clearbench.kernels.quaternion import (
     quat_to_matrix_batch,
 )
 from clearbench.scenarios.bodies import Motion
+from clearbench.scenarios.energy import Energy, mechanical_energy
 from clearbench.scenarios.features import LOAD_FEATURES, WORK_FEATURES
 from clearbench.scenarios.geometry import (
     contacts_between,
@@ -353,32 +354,6 @@ def stiction(scene: Scene, trajectory: Trajectory, body: str, start: float = 0.0
     return Stiction(float(np.max(np.abs(moved))) if len(moved) else 0.0, rate)
 
 
-@dataclass(frozen=True)
-class Energy:
-    """(T,) kinetic, gravitational potential, spring potential and contact energy, and their
-    total [M L^2 / T^2]. Time-switched forces, moments and drivers do work not counted here,
-    and so do law loads (``angle_law``, ``distance_law``): their forces are not the gradient of
-    a potential in general (a torsion law applied as a force on a body-fixed lever, a distance
-    law pushing along a body axis), so no potential energy exists to count for them; see
-    :func:`non_conservative_loads`. ``contacts`` is the elastic energy stored in the contacts
-    (:func:`contact_energy`)."""
-
-    kinetic: np.ndarray
-    gravity: np.ndarray
-    springs: np.ndarray
-    contacts: np.ndarray | float = 0.0
-
-    @property
-    def total(self) -> np.ndarray:
-        return self.kinetic + self.gravity + self.springs + self.contacts
-
-    def at(self, samples: np.ndarray) -> Energy:
-        """The same energies on a subset of the samples (boolean mask or indices)."""
-        contacts = self.contacts[samples] if np.ndim(self.contacts) else self.contacts
-        return Energy(self.kinetic[samples], self.gravity[samples], self.springs[samples],
-                      contacts)
-
-
 def contact_energy(scene: Scene, trajectory: Trajectory) -> np.ndarray:
     """Elastic energy stored in the contacts, (T,) [M L^2 / T^2]: per pair, half the normal
     force times the penetration, the work of a linear contact spring pressed to that depth,
@@ -406,34 +381,23 @@ def contact_energy(scene: Scene, trajectory: Trajectory) -> np.ndarray:
 
 
 def energy(scene: Scene, trajectory: Trajectory) -> Energy:
-    count = len(trajectory.times)
-    kinetic = np.zeros(count)
-    potential = np.zeros(count)
-    com = centre_of_mass_positions(scene, trajectory)
-    gravity = np.asarray(scene.gravity, dtype=float)
-    for b, body in enumerate(scene.bodies):
-        if body.motion is Motion.FIXED:
-            continue
-        v = trajectory.velocities[:, b]
-        w = trajectory.angular_velocities[:, b]
-        inertia = np.asarray(body.inertia, dtype=float)
-        kinetic += 0.5 * body.mass * np.sum(v * v, axis=1)
-        kinetic += 0.5 * np.einsum("ti,ij,tj->t", w, inertia, w)
-        potential -= body.mass * com[:, b] @ gravity
-    springs = np.zeros(count)
+    """Energy of every sample, (T,) each [M L^2 / T^2]
+    (:func:`~clearbench.scenarios.energy.mechanical_energy`, torsional springs at their
+    :func:`relative_angle`), with the contacts' stored energy (:func:`contact_energy`)."""
     q = quat_normalize_batch(trajectory.orientations)
-    for load in scene.loads:
-        if isinstance(load, LinearSpringDamper):
-            a, b = scene.body_index(load.body_a), scene.body_index(load.body_b)
-            pa = trajectory.positions[:, a] + quat_rotate_batch(q[:, a], np.asarray(load.point_a))
-            pb = trajectory.positions[:, b] + quat_rotate_batch(q[:, b], np.asarray(load.point_b))
-            stretch = np.linalg.norm(pb - pa, axis=1) - load.rest_length
-            springs += load.preload * stretch + 0.5 * load.stiffness * stretch**2
-        elif isinstance(load, TorsionalSpringDamper):
-            phi = relative_angle(trajectory, scene.body_index(load.body_a),
-                                 scene.body_index(load.body_b), load.axis)
-            springs += load.preload * phi + 0.5 * load.stiffness * (phi - load.rest_angle) ** 2
-    return Energy(kinetic, potential, springs, contact_energy(scene, trajectory))
+
+    def spring_points(load: LinearSpringDamper) -> tuple[np.ndarray, np.ndarray]:
+        a, b = scene.body_index(load.body_a), scene.body_index(load.body_b)
+        return (trajectory.positions[:, a] + quat_rotate_batch(q[:, a], np.asarray(load.point_a)),
+                trajectory.positions[:, b] + quat_rotate_batch(q[:, b], np.asarray(load.point_b)))
+
+    torsion = {load.name: relative_angle(trajectory, scene.body_index(load.body_a),
+                                         scene.body_index(load.body_b), load.axis)
+               for load in scene.loads if isinstance(load, TorsionalSpringDamper)}
+    parts = mechanical_energy(scene, centre_of_mass_positions(scene, trajectory),
+                              trajectory.velocities, trajectory.angular_velocities,
+                              spring_points, torsion)
+    return replace(parts, contacts=contact_energy(scene, trajectory))
 
 
 def non_conservative_loads(scene: Scene) -> tuple[str, ...]:

@@ -122,6 +122,8 @@ class Runner:
                  environment: Mapping[str, str] | None = None,
                  on_finished: Callable[[int, int, RunSpec, RunRecord], None] | None = None):
         self.store = store
+        # Trajectory files of runs a killed sweep left half written (``.KEY.PID.tmp.npz``).
+        store.clean_partial_files()
         self.environment = worker_environment(environment)
         self.jobs = max(1, int(jobs or default_jobs()))
         self.runs_per_worker = max(1, int(runs_per_worker))

@@ -338,8 +338,12 @@ class ResultsStore:
         return frame
 
     def clean_partial_files(self, older_than: float = 3600.0) -> int:
-        """Remove temporary trajectory files of runs interrupted more than ``older_than``
-        seconds ago; returns how many were removed."""
+        """Remove temporary trajectory files (``.KEY.PID.tmp.npz`` and their ``.partial.npz``)
+        of runs interrupted more than ``older_than`` seconds ago; returns how many were
+        removed. A :class:`~clearbench.harness.run.runner.Runner` calls it when it opens the
+        store: a run's temporary file lives from its end to its recording (seconds; its
+        measurement is bounded by ``MEASURE_TIMEOUT``), so an hour-old one was left by a sweep
+        that was killed."""
         removed = 0
         cutoff = time.time() - older_than
         for path in self.trajectory_dir.glob(".*.npz"):

@@ -42,7 +42,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.special import ellipj, ellipkinc
 
 from clearbench.scenarios.analytic.common import (
     as_times,
@@ -401,6 +400,7 @@ def rocking_block_fall_time(
         / (math.sin(0.5 * alpha) ** 2 * np.cos(0.5 * (alpha - amp)) ** 2)
     )
     phi = np.arcsin(np.sqrt(np.clip(sn_squared, 0.0, 1.0)))
+    from scipy.special import ellipkinc  # on use: scipy.special is slow to import
     return ellipkinc(phi, m) / p
 
 
@@ -527,6 +527,7 @@ def _from_rest(amplitude: np.ndarray, tau: np.ndarray, alpha: float, p: float, l
     # Exact: with psi = alpha - theta the angle of the corner-to-centre line from the vertical,
     # psi'' = p^2 sin(psi), i.e. sin(psi / 2) = sin(psi0 / 2) / dn(p tau | m).
     m = _exact_modulus(amplitude, alpha)
+    from scipy.special import ellipj  # on use: scipy.special is slow to import
     sn, cn, dn, _ = ellipj(p * tau, m)
     complement = np.sin(0.5 * (alpha - amplitude))  # sqrt(1 - m)
     half_psi = np.arcsin(np.minimum(complement / dn, 1.0))

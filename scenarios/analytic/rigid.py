@@ -52,7 +52,6 @@ from dataclasses import dataclass
 from enum import IntEnum
 
 import numpy as np
-from scipy.special import ellipj, ellipk, ellipkinc, ellipkm1
 
 from clearbench.scenarios.analytic.common import as_times, require_finite, require_positive
 
@@ -145,6 +144,7 @@ def pendulum_period(theta0: float, natural_frequency: float) -> float:
     theta0, omega0 = _check_pendulum(theta0, natural_frequency)
     # K(m) through ellipkm1(1 - m): 1 - m = cos^2(theta0/2) keeps its relative precision near
     # the top, where forming m = sin^2(theta0/2) first would lose it (K ~ ln(4 / sqrt(1 - m))).
+    from scipy.special import ellipkm1  # on use: scipy.special is slow to import
     return 4.0 * float(ellipkm1(math.cos(0.5 * theta0) ** 2)) / omega0
 
 
@@ -152,6 +152,7 @@ def _pendulum_jacobi(t, theta0: float, natural_frequency: float):
     theta0, omega0 = _check_pendulum(theta0, natural_frequency)
     times = as_times(t, non_negative=False)
     modulus = math.sin(0.5 * theta0)  # signed k; only k^2 enters ellipj
+    from scipy.special import ellipj  # on use: scipy.special is slow to import
     sn, cn, dn, _ = ellipj(omega0 * times, modulus**2)
     return modulus, math.cos(0.5 * theta0), omega0, sn, cn, dn
 
@@ -320,6 +321,7 @@ class TorqueFreePolhode:
         """Period of the body angular velocity, ``4 K(m) / |lambda|`` [time] (inf if m = 1)."""
         if self.steady or self.rate == 0.0:
             return math.inf
+        from scipy.special import ellipk  # on use: scipy.special is slow to import
         return 4.0 * float(ellipk(self.parameter)) / abs(self.rate)
 
 
@@ -377,6 +379,7 @@ def torque_free_polhode(principal_moments, omega0) -> TorqueFreePolhode:
         amplitude_angle = math.atan2(w2 * a3, w3 * a2)
         axis, amplitudes = PolhodeAxis.MINOR, (math.copysign(a1, w1), a2, a3)
     parameter = min(max(parameter, 0.0), 1.0)
+    from scipy.special import ellipkinc  # on use: scipy.special is slow to import
     phase = float(ellipkinc(amplitude_angle, parameter))
     return TorqueFreePolhode(
         moments_tuple, axis, amplitudes, rate, parameter, phase, not math.isfinite(phase)
@@ -404,6 +407,7 @@ def torque_free_angular_velocity(t, principal_moments, omega0) -> np.ndarray:
     times = as_times(t, non_negative=False)
     if polhode.steady:
         return np.broadcast_to(np.asarray(polhode.amplitudes), (*times.shape, 3)).copy()
+    from scipy.special import ellipj  # on use: scipy.special is slow to import
     sn, cn, dn, _ = ellipj(polhode.rate * times + polhode.phase, polhode.parameter)
     a1, a2, a3 = polhode.amplitudes
     if polhode.encircled_axis == PolhodeAxis.MAJOR:

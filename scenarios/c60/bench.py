@@ -89,7 +89,7 @@ def contact_force_test_scene(
 
     The library scene ``c60-contact-force-test`` puts the handle spring at its design arm
     unless told otherwise (10 N mm about the handle's pivot
-    instead of the source's 27, see :mod:`.c60_model`). Measured with the reference engine
+    instead of the source's 27, see :mod:`.model`). Measured with the reference engine
     over the first 10 ms (``clearbench c60 angles`` on the trajectory): with the
     source's arm the handle leaves its ON pose within 1 ms of the moving contact landing on
     C6 (-0.34 rad at 6 ms, +0.68 rad at 10 ms, stroke 2.2 mm) and the mechanism opens; with

@@ -1,4 +1,4 @@
-"""The C-60 model's documented alternatives as named, validated parameters (issue 18).
+"""The C-60 model's documented alternatives as named, validated parameters.
 
 The source (``plugins/plugin1.cpp`` of the Siconos example, see ``data/README.md``) carries,
 in comments beside the values it uses, the values of other versions of its laws:

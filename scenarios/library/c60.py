@@ -5,7 +5,7 @@
 * ``c60-trip``: the source's magnetic trip: the plunger moves at 0.2 mm/ms from 0.7 ms, strikes
   the tripping bar, the latch releases and the contacts open (20 ms, as the source).
 * ``c60-contact-force-test`` and ``c60-trip-force-test``: the bench experiments of Section 5
-  with the prototype's clearances (Table 7), see :mod:`.c60_bench`.
+  with the prototype's clearances (Table 7), see :mod:`clearbench.scenarios.c60.bench`.
 
 Every factory takes ``clearances`` (joint -> radial clearance [mm]), ``time_step`` and
 ``horizon`` [ms] where it applies, a named model ``variant`` (``source`` by default; the
@@ -15,17 +15,17 @@ variant, the fields of :class:`~clearbench.scenarios.c60.variants.ModelParameter
 ``contact_spring_preload`` [rad], ``contact_spring_angle_offset`` [deg],
 ``moving_contact_force_lever`` and ``plate_force_lever`` [mm], ``handle_spring_arm``
 (``source``/``design``; the contact-force test takes ``design`` unless told, see
-:mod:`.c60_bench`), ``friction_set`` (``source``/``paper-table-4``) and ``friction``
-(contact class -> coefficient, e.g. ``friction={"C4": 0.1}``). A bad value is refused naming
-the field before the scene is built.
+:mod:`clearbench.scenarios.c60.bench`), ``friction_set`` (``source``/``paper-table-4``) and
+``friction`` (contact class -> coefficient, e.g. ``friction={"C4": 0.1}``). A bad value is
+refused naming the field before the scene is built.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 
-from clearbench.scenarios.c60 import bench as c60_bench
-from clearbench.scenarios.c60 import model as c60_model
+from clearbench.scenarios.c60.bench import contact_force_test_scene, trip_force_test_scene
+from clearbench.scenarios.c60.model import c60_scene
 from clearbench.scenarios.c60.variants import model_parameters
 from clearbench.scenarios.expectations import Expectation
 from clearbench.scenarios.registry import register
@@ -40,7 +40,7 @@ SETTLED_AFTER = 3.0
           summary="C-60 breaker in its ON pose: settles, stays latched; FC-1..FC-6")
 def c60_on(clearances: Mapping[str, float] | None = None, horizon: float = 7.0,
            time_step: float = 1e-3, variant: str = "source", **model) -> Scene:
-    return c60_model.c60_scene(
+    return c60_scene(
         "c60-on", clearances=clearances, horizon=horizon, time_step=time_step,
         parameters=model_parameters(variant, **model), plunger_speed=0.0,
         expectations=(
@@ -60,7 +60,7 @@ def c60_on(clearances: Mapping[str, float] | None = None, horizon: float = 7.0,
 def c60_trip(clearances: Mapping[str, float] | None = None, horizon: float = 20.0,
              time_step: float = 1e-3, plunger_speed: float = 0.2, plunger_start: float = 0.7,
              variant: str = "source", **model) -> Scene:
-    return c60_model.c60_scene(
+    return c60_scene(
         "c60-trip", clearances=clearances, horizon=horizon, time_step=time_step,
         parameters=model_parameters(variant, **model), plunger_speed=plunger_speed,
         plunger_start=plunger_start,
@@ -76,7 +76,7 @@ def c60_contact_force_test(clearances: Mapping[str, float] | None = None,
                            probe_speed: float = 0.1, time_step: float = 1e-3,
                            variant: str = "source", **model) -> Scene:
     model.setdefault("handle_spring_arm", "design")
-    return c60_bench.contact_force_test_scene(
+    return contact_force_test_scene(
         clearances=clearances, probe_speed=probe_speed, time_step=time_step,
         parameters=model_parameters(variant, **model))
 
@@ -86,6 +86,6 @@ def c60_contact_force_test(clearances: Mapping[str, float] | None = None,
 def c60_trip_force_test(clearances: Mapping[str, float] | None = None,
                         probe_speed: float = 0.02, time_step: float = 1e-3,
                         variant: str = "source", **model) -> Scene:
-    return c60_bench.trip_force_test_scene(
+    return trip_force_test_scene(
         clearances=clearances, probe_speed=probe_speed, time_step=time_step,
         parameters=model_parameters(variant, **model))

@@ -29,7 +29,7 @@ import sys
 import tempfile
 import time
 import uuid
-from collections.abc import Callable, Iterable
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from datetime import UTC, datetime
 
@@ -297,8 +297,3 @@ def run_samples(definition: CampaignDefinition, samples: list[CampaignSample],
         if cluster is not None:
             cluster.close()
     return outcome
-
-
-def campaign_keys(samples: Iterable[CampaignSample]) -> list[str]:
-    """Run keys of ``samples``, in sample order."""
-    return [sample.spec.key for sample in samples]
