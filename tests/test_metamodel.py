@@ -214,14 +214,20 @@ def test_the_degree_search_chooses_a_chaos_for_ishigami():
     assert fitted.candidates["kriging"] < fitted.q2
 
 
-def test_a_linear_models_failure_probability_matches_the_normal_tail():
+def linear_metamodel():
+    """The chaos of y = 2 + a + 2 b (a, b standard normal: y ~ N(2, 5)) from 32 runs, and
+    the inputs' law."""
     definition = parse_campaign(function_campaign([standard_normal("a"),
                                                    standard_normal("b")], samples=32))
     x = sample_inputs(definition)
-    y = 2.0 + x[:, 0] + 2.0 * x[:, 1]          # N(2, 5)
+    y = 2.0 + x[:, 0] + 2.0 * x[:, 1]
     distribution = input_distribution(definition)
-    basis = ChaosBasis(distribution)
-    fitted = choose_metamodel(x, y, basis, candidates=("chaos",), max_degree=1)
+    return choose_metamodel(x, y, ChaosBasis(distribution), candidates=("chaos",),
+                            max_degree=1), distribution
+
+
+def test_a_linear_models_failure_probability_matches_the_normal_tail():
+    fitted, distribution = linear_metamodel()
     scale = math.sqrt(5.0)
     lower, upper = 2.0 - 4.0 * scale, 2.0 + 4.5 * scale    # beta 4 and 4.5
     exact = stats.norm.cdf(-4.0) + stats.norm.cdf(-4.5)     # 35.07 PPM
@@ -240,13 +246,7 @@ def test_a_linear_models_failure_probability_matches_the_normal_tail():
 
 
 def test_a_side_the_median_inputs_already_fail_is_estimated_by_plain_monte_carlo():
-    definition = parse_campaign(function_campaign([standard_normal("a"),
-                                                   standard_normal("b")], samples=32))
-    x = sample_inputs(definition)
-    y = 2.0 + x[:, 0] + 2.0 * x[:, 1]          # N(2, 5)
-    distribution = input_distribution(definition)
-    fitted = choose_metamodel(x, y, ChaosBasis(distribution), candidates=("chaos",),
-                              max_degree=1)
+    fitted, distribution = linear_metamodel()
     scale = math.sqrt(5.0)
     # the lower limit half a sigma above the median: P(y < LSL) = Phi(0.5) = 69 %, the
     # median design fails (post-analytical importance sampling centred on the design point

@@ -114,18 +114,10 @@ def side_probability(fitted: FittedModel, distribution, side: str, limit: float,
                             form=float(result.getEventProbability()), beta=beta)
     probability = float(result.getEventProbability())
     ot.RandomGenerator.SetSeed(seed)
-    sampling = ot.PostAnalyticalImportanceSampling(result)
-    sampling.setBlockSize(BLOCK)
-    sampling.setMaximumOuterSampling(MAXIMUM_DRAWS // BLOCK)
-    sampling.setMaximumCoefficientOfVariation(TARGET_CV)
-    sampling.run()
-    simulated = sampling.getResult()
-    estimate = float(simulated.getProbabilityEstimate())
-    cv = float(simulated.getCoefficientOfVariation()) if estimate > 0 else math.nan
+    estimate, cv, draws = _simulate(ot.PostAnalyticalImportanceSampling(result))
     return LimitEstimate(
         side=side, limit=float(limit), form=probability, beta=beta, origin_fails=origin_fails,
-        importance=estimate, importance_cv=cv,
-        draws=int(simulated.getOuterSampling() * simulated.getBlockSize()),
+        importance=estimate, importance_cv=cv, draws=draws,
         design_point=list(np.asarray(result.getPhysicalSpaceDesignPoint(), float)[:d]),
         standard_point=list(np.asarray(result.getStandardSpaceDesignPoint(), float)))
 
@@ -137,7 +129,20 @@ def _monte_carlo(event, side: str, limit: float, seed: int, note: str,
     figures are kept beside it)."""
     ot = _ot()
     ot.RandomGenerator.SetSeed(seed)
-    algorithm = ot.ProbabilitySimulationAlgorithm(event, ot.MonteCarloExperiment())
+    estimate, cv, draws = _simulate(
+        ot.ProbabilitySimulationAlgorithm(event, ot.MonteCarloExperiment()))
+    note += "; plain Monte Carlo on the metamodel"
+    if estimate >= 1:   # the binomial rule of three bounds the probability
+        note += f", all {draws} draws fail (P >= {1 - 3 / draws:.6g} at 95 %)"
+    return LimitEstimate(side=side, limit=float(limit), form=form, beta=beta,
+                         origin_fails=estimate > 0.5, importance=estimate, importance_cv=cv,
+                         draws=draws, note=note)
+
+
+def _simulate(algorithm) -> tuple[float, float, int]:
+    """Run an OpenTURNS simulation ``algorithm`` in blocks of ``BLOCK`` draws to ``TARGET_CV``
+    or ``MAXIMUM_DRAWS``: (probability, coefficient of variation, draws). The CV is nan when no
+    draw fails and 0 when every draw does (no spread to estimate; OpenTURNS reports -1)."""
     algorithm.setBlockSize(BLOCK)
     algorithm.setMaximumOuterSampling(MAXIMUM_DRAWS // BLOCK)
     algorithm.setMaximumCoefficientOfVariation(TARGET_CV)
@@ -145,19 +150,11 @@ def _monte_carlo(event, side: str, limit: float, seed: int, note: str,
     simulated = algorithm.getResult()
     estimate = float(simulated.getProbabilityEstimate())
     draws = int(simulated.getOuterSampling() * simulated.getBlockSize())
-    note += "; plain Monte Carlo on the metamodel"
     if estimate <= 0:
-        cv = math.nan
-    elif estimate >= 1:
-        # every draw fails: no spread to estimate (OpenTURNS reports a CV of -1); the
-        # binomial rule of three bounds the probability instead
-        cv = 0.0
-        note += f", all {draws} draws fail (P >= {1 - 3 / draws:.6g} at 95 %)"
-    else:
-        cv = float(simulated.getCoefficientOfVariation())
-    return LimitEstimate(side=side, limit=float(limit), form=form, beta=beta,
-                         origin_fails=estimate > 0.5, importance=estimate, importance_cv=cv,
-                         draws=draws, note=note)
+        return estimate, math.nan, draws
+    if estimate >= 1:
+        return estimate, 0.0, draws
+    return estimate, float(simulated.getCoefficientOfVariation()), draws
 
 
 def confirmation_points(distribution, estimate: LimitEstimate, count: int,
