@@ -8,10 +8,11 @@ time profiles),
 subpackage per engine) and ``clearbench.harness`` (runner, metrics, store, report, CLI).
 
 Importing the package points numba's on-disk cache (``NUMBA_CACHE_DIR``, unless the user set
-it) at a directory named after the state of the package's sources (and numba's code-generation
-settings, when set: :func:`numba_cache_dir`). numba keys a cached kernel on its own file only: a
-kernel that inlines a function from another module would otherwise keep running the old code
-after that module is edited (it did once, and hid a fix).
+it) at a directory named after the state of the sources compiled kernels can read (every
+sub-package but the harness, whose modules hold no kernel another module calls) and numba's
+code-generation settings, when set (:func:`numba_cache_dir`). numba keys a cached kernel on its
+own file only: a kernel that inlines a function from another module would otherwise keep running
+the old code after that module is edited (it did once, and hid a fix).
 """
 
 import functools
@@ -25,6 +26,11 @@ __version__ = "0.1.0"
 
 _SUBPACKAGES = ("clearbench.kernels", "clearbench.scenarios", "clearbench.ref_solver",
                 "clearbench.adapters", "clearbench.harness")
+
+#: The sub-packages whose sources numba's cache directory is named after: those holding kernels
+#: or the constants and helpers kernels inline. An edit of the harness keeps the compiled
+#: kernels (a cold compile of every kernel costs minutes).
+_KERNEL_SUBPACKAGES = _SUBPACKAGES[:-1]
 
 
 def _source_files(subpackages: tuple[str, ...]):
@@ -40,10 +46,11 @@ def _source_files(subpackages: tuple[str, ...]):
 
 @functools.cache
 def _sources_fingerprint() -> str:
-    """Digest of the path, size and modification time of every source file [hex, 16 chars],
-    computed once per process (every cache directory a process names is of one state)."""
+    """Digest of the path, size and modification time of every source file of
+    :data:`_KERNEL_SUBPACKAGES` [hex, 16 chars], computed once per process (every cache
+    directory a process names is of one state)."""
     digest = hashlib.sha1(__version__.encode())
-    for _, _, path in _source_files(_SUBPACKAGES):
+    for _, _, path in _source_files(_KERNEL_SUBPACKAGES):
         stat = path.stat()
         digest.update(f"{path}:{stat.st_size}:{stat.st_mtime_ns}\n".encode())
     return digest.hexdigest()[:16]
