@@ -50,8 +50,8 @@ def _pick(table: Mapping, extra: tuple, key: str):
 
 @functools.cache
 def _registered_colours() -> tuple[tuple[str, str], ...]:
-    return tuple((name, engine_defaults(name).colour) for name in engine_names()
-                 if engine_defaults(name).colour)
+    declared = ((name, engine_defaults(name).colour) for name in engine_names())
+    return tuple((name, colour) for name, colour in declared if colour)
 
 
 def engine_colours(extra_modules: Mapping[str, str] | None = None) -> dict[str, str]:

@@ -150,8 +150,7 @@ def with_declared_runs(baseline: dict, engines: Sequence[str],
     """``baseline`` with the quick runs each of ``engines`` (names) declares appended to its
     suite, for those that have no entry in it yet; and the names that got them. This is how a
     new engine's runs enter a committed baseline (``clearbench regress --update -e NAME``)."""
-    present = {engine_name(entry.get("engine")) for entry in baseline["suite"]}
-    added = [name for name in engines if name not in present]
+    added = engines_without_runs(baseline, engines, extra_modules)
     if not added:
         return baseline, []
     return {**baseline, "suite": [*baseline["suite"], *default_suite(added, extra_modules)]}, \
@@ -173,8 +172,8 @@ def restricted(baseline: dict, selection: EngineSelection | None) -> tuple[dict,
     if selection is None:
         return baseline, []
     taken = [entry for entry in baseline["suite"] if selection.takes(entry)]
+    others = [entry.get("id") for entry in baseline["suite"] if not selection.takes(entry)]
     ids = {entry.get("id") for entry in taken}
-    others = [entry.get("id") for entry in baseline["suite"] if entry.get("id") not in ids]
     return {**baseline, "suite": taken,
             "results": {i: r for i, r in baseline.get("results", {}).items() if i in ids}}, \
         others
