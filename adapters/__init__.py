@@ -8,7 +8,11 @@ engine subpackage until it is asked about, and asking about availability imports
 adapter's modules nor the engine's Python package (:func:`installed_package`,
 :func:`lazy_engine`): ``clearbench list`` stays quick.
 
-Adding an engine: a subpackage with those two functions and an
+Each ``__init__`` also declares the engine's ``HARNESS_DEFAULTS``
+(:mod:`clearbench.adapters.harness_defaults`: its quick regression runs, rigid or compliant,
+numba, C-60 ladders, colour), from which the harness derives its suites, plans and styles.
+
+Adding an engine: a subpackage with those two functions, its ``HARNESS_DEFAULTS`` and an
 :class:`~clearbench.adapters.base.Engine` subclass, and its line in :data:`ENGINES`; the
 engine-contract test then runs it over every library scene.
 """

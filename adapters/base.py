@@ -117,6 +117,8 @@ class Engine(ABC):
     #: Whether contacts are rigid (impulses, no contact spring: nonsmooth engines) rather than
     #: compliant; recorded in each trajectory's metadata as ``rigid_contacts``. A rigid engine
     #: stores no elastic energy in its contacts (``harness.measure.series.contact_energy``).
+    #: An engine subpackage sets it from its declaration to the harness
+    #: (``HARNESS_DEFAULTS.rigid_contacts``, :mod:`clearbench.adapters.harness_defaults`).
     RIGID_CONTACTS: ClassVar[bool] = False
 
     def __init__(self, preset: str = "default"):

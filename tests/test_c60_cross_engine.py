@@ -17,7 +17,7 @@ from clearbench.harness.report.c60_section import (
 )
 from clearbench.harness.report.engine_style import engine_style
 from clearbench.harness.run.engine_choice import EngineChoice
-from clearbench.harness.studies.c60_comparison import DEMO, plan_engines, plan_runs
+from clearbench.harness.studies.c60_comparison import c60_plan, plan_engines, plan_runs
 from clearbench.scenarios.library import get_scene
 
 FC_REST = {"FC-2": 10.62, "FC-3": 2.83, "FC-4": 10.73, "FC-5": 2.29, "FC-6": 0.51}
@@ -126,14 +126,15 @@ def test_joint_excess_groups_the_ring_pairs_by_joint():
 def test_demo_plan_runs_reference_first_with_shortened_horizons():
     engines = [EngineChoice("mujoco", "tuned", "clearbench.adapters.mujoco", ""),
                EngineChoice("reference", "default", "clearbench.adapters.reference", "")]
-    specs = plan_runs(DEMO, engines)
+    demo = c60_plan("demo")
+    specs = plan_runs(demo, engines)
     assert specs[0].engine.label == "reference[default]"
     assert {s.engine.label for s in specs} == {"reference[default]", "mujoco[tuned]"}
     for spec in specs:
-        assert spec.horizon == DEMO.horizons[spec.scene.name]
+        assert spec.horizon == demo.horizons[spec.scene.name]
         # about one sample per 0.01 ms, whatever the step
         assert math.isclose(spec.record_every * spec.time_step, 0.01, rel_tol=0.5)
-    _, left_out = plan_engines(DEMO, ["nosuch[default]"])
+    _, left_out = plan_engines(demo, ["nosuch[default]"])
     assert "nosuch[default]" in left_out and "unknown engine" in left_out["nosuch[default]"]
 
 

@@ -7,8 +7,8 @@ import copy
 import json
 
 from clearbench.harness.cli.main import main
+from clearbench.harness.run.engine_choice import engine_defaults
 from clearbench.harness.studies.regress import (
-    ENGINE_PRESETS,
     compare,
     measure_baseline,
     suite_entries,
@@ -89,11 +89,11 @@ def test_regress_covers_one_quick_scene_per_available_engine():
     """Every available engine on a quick scene: the baseline measured from a run and one
     round-off perturbation passes its own runs, and a moved figure is a regression naming the
     engine, the scene, the figure and the version."""
-    from clearbench.adapters import all_availability
+    from clearbench.adapters import ENGINES, all_availability
 
-    suite = [{"id": f"{name}[{ENGINE_PRESETS.get(name, 'default')}] incline-stick",
-              "scene": "incline-stick", "engine": f"{name}[{ENGINE_PRESETS.get(name, 'default')}]",
-              "horizon": 0.05} for name in ENGINE_PRESETS | {"reference": "default"}]
+    labels = [f"{name}[{engine_defaults(name).regress_preset}]" for name in ENGINES]
+    suite = [{"id": f"{label} incline-stick", "scene": "incline-stick", "engine": label,
+              "horizon": 0.05} for label in labels]
     baseline = {"suite": suite, "perturbations": ROUNDOFF_ONLY, "results": {}}
     skipped: dict = {}
     specs = suite_specs(baseline, skipped=skipped)

@@ -14,7 +14,7 @@ import pytest
 
 from clearbench.harness.studies.regress import compare, measure_baseline, run_suite
 from clearbench.harness.studies.regress.measure import variant_spec
-from clearbench.harness.studies.regress.perturbations import DEFAULT_PERTURBATIONS, Variant
+from clearbench.harness.studies.regress.perturbations import GENERIC_PERTURBATIONS, Variant
 from clearbench.harness.studies.regress.suite import entry_spec
 
 #: The sliding box to its stop (0.68 s at mu 0.3): its stop distance is v0^2 / (2 mu g).
@@ -27,7 +27,7 @@ BOUNCING_BALL = {"id": "bouncing-ball-e0.5", "scene": "bouncing-ball-e0.5",
 CLEARANCE_PENDULUM = {"id": "clearance-pendulum", "scene": "clearance-pendulum",
                       "engine": "reference", "horizon": 0.1}
 
-ROUNDOFF_ONLY = [p for p in DEFAULT_PERTURBATIONS if p["kind"] == "roundoff"]
+ROUNDOFF_ONLY = [p for p in GENERIC_PERTURBATIONS if p["kind"] == "roundoff"]
 
 
 def _measured(entries: list[dict], perturbations: list[dict]) -> dict:
@@ -65,7 +65,7 @@ def test_a_friction_one_percent_off_is_caught_and_round_off_is_not():
 @pytest.mark.slow
 def test_restitution_friction_and_clearance_changes_are_caught_under_every_perturbation():
     entries = [SLIDING_BOX, BOUNCING_BALL, CLEARANCE_PENDULUM]
-    baseline = _measured(entries, DEFAULT_PERTURBATIONS)
+    baseline = _measured(entries, GENERIC_PERTURBATIONS)
     changed = [_changed(SLIDING_BOX, friction=0.303),
                _changed(BOUNCING_BALL, restitution=0.55),
                _changed(CLEARANCE_PENDULUM, radial_clearance=1.1e-4)]

@@ -23,9 +23,13 @@ from clearbench.harness.studies.regress.tolerance import (
     figure_dimension,
 )
 
+#: The contacts of the engine a figure comes from: rigid (the reference, Siconos) or
+#: compliant (MuJoCo, PyBullet, Exudyn), as each declares (HARNESS_DEFAULTS.rigid_contacts).
+RIGID, COMPLIANT = True, False
+
 
 def test_a_figure_moved_by_round_off_is_exact_within_its_widened_spread():
-    check = classify("apex_heights.rest_time", "reference", 1.0, [1.0 + 1e-15, 1.0 - 3e-15],
+    check = classify("apex_heights.rest_time", RIGID, 1.0, [1.0 + 1e-15, 1.0 - 3e-15],
                      scale=1.0)
     assert check.kind == "exact" and check.spread == pytest.approx(3e-15)
     # tolerance = 10 x 3e-15 + 1e-8 x max(1, 1): the floor dominates.
@@ -35,7 +39,7 @@ def test_a_figure_moved_by_round_off_is_exact_within_its_widened_spread():
 
 def test_a_spread_of_zero_does_not_make_the_check_bitwise():
     # A length of 0.68 m in a scene of size 1.1 m: floor 1e-8 x 1.1 m = 1.1e-8 m.
-    check = classify("stop.stop_distance", "reference", 0.68, [0.68, 0.68], scale=1.1)
+    check = classify("stop.stop_distance", RIGID, 0.68, [0.68, 0.68], scale=1.1)
     assert check.kind == "exact" and check.spread == 0.0
     assert check.allows(0.68 + 1e-8) and not check.allows(0.68 + 1.2e-8)
     # A 1 % friction change moves the stop distance by 1 %: six orders above the floor.
@@ -44,7 +48,7 @@ def test_a_spread_of_zero_does_not_make_the_check_bitwise():
 
 def test_energy_growth_is_checked_as_a_bound_not_as_equality():
     # The clearance pendulum's contact-free energy growth on two CPUs (issue's figures).
-    check = classify("energy_growth_contact_free", "reference", 9.6552e-07,
+    check = classify("energy_growth_contact_free", RIGID, 9.6552e-07,
                      [9.61e-07, 9.70e-07], scale=1.0)
     assert check.kind == "bounded"
     assert check.limit == pytest.approx(BOUND_HEADROOM * 9.70e-07)
@@ -54,11 +58,11 @@ def test_energy_growth_is_checked_as_a_bound_not_as_equality():
 
 
 def test_a_rigid_engines_penetration_is_bounded_a_compliant_engines_is_not():
-    rigid = classify("penetration_max", "reference", 6.9e-18, [0.0, 1.4e-17], scale=1.1)
+    rigid = classify("penetration_max", RIGID, 6.9e-18, [0.0, 1.4e-17], scale=1.1)
     assert rigid.kind == "bounded"
     # Round-off values: the floor 1e-8 x the scene's size is the bound.
     assert rigid.limit == pytest.approx(FLOOR_RELATIVE * 1.1)
-    soft = classify("penetration_max", "mujoco", 1.2e-4, [1.2e-4, 1.2e-4], scale=1.1)
+    soft = classify("penetration_max", COMPLIANT, 1.2e-4, [1.2e-4, 1.2e-4], scale=1.1)
     assert soft.kind == "exact"
     # 1 % more penetration (a softer contact) is 1.2e-6 m, above the floor of 1.1e-8 m.
     assert not soft.allows(1.2e-4 * 1.01)
@@ -66,7 +70,7 @@ def test_a_rigid_engines_penetration_is_bounded_a_compliant_engines_is_not():
 
 def test_a_chaotic_figure_is_judged_against_its_ensembles_widened_range():
     ensemble = [8.9e-4, 1.0e-3, 9.5e-4, 9.9e-4, 9.1e-4, 9.7e-4, 1.01e-3, 9.3e-4]
-    check = classify("fc1_force", "pybullet", 8.94e-4, ensemble, scale=50.0)
+    check = classify("fc1_force", COMPLIANT, 8.94e-4, ensemble, scale=50.0)
     assert check.kind == "statistical" and check.samples == 8
     assert check.low == 8.9e-4 and check.high == 1.01e-3
     # margin = 1 x the range (1.2e-4) + floor 1e-8 x 50 = 5e-7.
@@ -77,16 +81,16 @@ def test_a_chaotic_figure_is_judged_against_its_ensembles_widened_range():
 
 
 def test_nan_passes_only_where_it_was_measured():
-    stopped_in_some = classify("stop.stop_time", "reference", 0.7, [math.nan, 0.7], 1.0)
+    stopped_in_some = classify("stop.stop_time", RIGID, 0.7, [math.nan, 0.7], 1.0)
     assert stopped_in_some.allows(math.nan)
-    never = classify("stop.stop_time", "reference", math.nan, [math.nan], 1.0)
+    never = classify("stop.stop_time", RIGID, math.nan, [math.nan], 1.0)
     assert never.kind == "exact" and never.allows(math.nan) and not never.allows(0.7)
-    finite = classify("error", "reference", 1e-3, [1e-3], 1.0)
+    finite = classify("error", RIGID, 1e-3, [1e-3], 1.0)
     assert not finite.allows(math.nan) and not finite.allows(math.inf)
 
 
 def test_iteration_counts_get_a_floor_of_whole_iterations():
-    check = classify("solver_iterations_mean", "reference", 1.08, [1.08, 1.08], 1.0)
+    check = classify("solver_iterations_mean", RIGID, 1.08, [1.08, 1.08], 1.0)
     # 5 % of 1.08 plus half an iteration.
     assert check.limit == pytest.approx(0.05 * 1.08 + 0.5)
     assert check.allows(1.5) and not check.allows(2.2)
@@ -105,7 +109,7 @@ def test_figure_dimensions():
 
 
 def test_check_round_trips_through_json_safe_dicts():
-    check = classify("stop.stop_time", "reference", math.nan, [math.nan], 1.0)
+    check = classify("stop.stop_time", RIGID, math.nan, [math.nan], 1.0)
     data = check.to_dict()
     assert data["base"] == "nan" and Check.from_dict(data).to_dict() == data
     assert math.isnan(Check.from_dict(data).base)
@@ -129,8 +133,8 @@ def _result(status="ok", passed=1, **metrics) -> dict:
 
 def test_compare_names_the_run_the_figure_the_values_and_the_criterion():
     baseline = _baseline(
-        stop_distance=classify("stop_distance", "reference", 0.68, [0.68], 1.1),
-        energy_growth=classify("energy_growth", "reference", 1e-15, [2e-15], 1.0))
+        stop_distance=classify("stop_distance", RIGID, 0.68, [0.68], 1.1),
+        energy_growth=classify("energy_growth", RIGID, 1e-15, [2e-15], 1.0))
     outcome = compare(baseline, _result(stop_distance=0.6732, energy_growth=3e-15))
     assert outcome.regressions == [
         "reference sliding-box: stop_distance 0.68 -> 0.6732 (exact: tolerance 1.1e-08, "
@@ -143,7 +147,7 @@ def test_compare_names_the_run_the_figure_the_values_and_the_criterion():
 
 
 def test_compare_accepts_a_status_seen_under_a_perturbation_only():
-    baseline = _baseline(x=classify("x", "exudyn", 1.0, [1.0], 1.0))
+    baseline = _baseline(x=classify("x", COMPLIANT, 1.0, [1.0], 1.0))
     entry = baseline["results"]["reference sliding-box"]
     entry["statuses_seen"] = ["diverged", "ok"]
     entry["expectations_seen"] = [0, 1]
@@ -155,7 +159,7 @@ def test_compare_accepts_a_status_seen_under_a_perturbation_only():
 
 
 def test_compare_notes_skipped_runs_and_scene_changes():
-    baseline = _baseline(x=classify("x", "reference", 1.0, [1.0], 1.0))
+    baseline = _baseline(x=classify("x", RIGID, 1.0, [1.0], 1.0))
     baseline["results"]["reference sliding-box"]["scene_hash"] = "a" * 64
     results = _result(x=1.0)
     results["reference sliding-box"]["scene_hash"] = "b" * 64
@@ -211,12 +215,12 @@ def test_a_numba_code_generation_variable_gets_its_own_cache_directory(monkeypat
 
 def test_the_warm_up_runs_each_reference_scene_for_two_steps_with_a_long_limit():
     from clearbench.harness.studies.regress.suite import (
-        DEFAULT_SUITE,
         WARM_UP_TIMEOUT,
+        default_suite,
         warm_up_specs,
     )
 
-    entries = {e["id"]: e for e in DEFAULT_SUITE}
+    entries = {e["id"]: e for e in default_suite()}
     specs = warm_up_specs(entries)
     assert sorted(s.scene.name for s in specs) == sorted(
         ["bouncing-ball-e0.5", "incline-stick", "sliding-box", "pendulum",

@@ -18,7 +18,7 @@ import numpy as np
 from clearbench.adapters.base import ModuleEngine, RunSettings
 from clearbench.adapters.options import OptionError
 from clearbench.adapters.recording import SampleRecorder, step_count
-from clearbench.adapters.reference import capabilities
+from clearbench.adapters.reference import HARNESS_DEFAULTS, capabilities
 from clearbench.adapters.reference.build import build
 from clearbench.adapters.reference.settings import (
     OPTIONS,
@@ -45,7 +45,7 @@ class ReferenceEngine(ModuleEngine):
     """Our nonsmooth reference solver (see :mod:`clearbench.ref_solver.stepper`)."""
 
     name = "reference"
-    RIGID_CONTACTS = True
+    RIGID_CONTACTS = HARNESS_DEFAULTS.rigid_contacts
     PRESETS = PRESETS
     OPTIONS = OPTIONS
     CAPABILITIES = capabilities

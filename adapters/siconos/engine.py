@@ -52,7 +52,7 @@ from pathlib import Path
 import numpy as np
 
 from clearbench.adapters.base import ModuleEngine, RunSettings
-from clearbench.adapters.siconos import capabilities
+from clearbench.adapters.siconos import HARNESS_DEFAULTS, capabilities
 from clearbench.adapters.siconos.process import (
     SICONOS_PYTHON,
     WorkerStatus,
@@ -95,7 +95,7 @@ class SiconosEngine(ModuleEngine):
     """Siconos 4.4 kernel (Moreau-Jean, fc3d / GenericMechanical) in a worker process."""
 
     name = "siconos"
-    RIGID_CONTACTS = True
+    RIGID_CONTACTS = HARNESS_DEFAULTS.rigid_contacts
     PRESETS = PRESETS
     OPTIONS = OPTIONS
     CAPABILITIES = capabilities

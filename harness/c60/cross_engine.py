@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from clearbench.adapters.harness_defaults import C60_ON, C60_TRIP
 from clearbench.adapters.trajectory import Trajectory
 from clearbench.harness.c60 import analysis
 from clearbench.harness.measure import series as metrics
@@ -21,9 +22,10 @@ from clearbench.scenarios.c60 import model
 from clearbench.scenarios.library.c60 import SETTLED_AFTER
 from clearbench.scenarios.scene import Scene
 
-#: The two scenes of the cross-engine comparison.
-ON_SCENE = "c60-on"
-TRIP_SCENE = "c60-trip"
+#: The two scenes of the cross-engine comparison (named where the engines declare their
+#: ladders for them).
+ON_SCENE = C60_ON
+TRIP_SCENE = C60_TRIP
 C60_SCENES = (ON_SCENE, TRIP_SCENE)
 #: The engine every other is measured against (ratios of wall time, errors of FC-1).
 REFERENCE_LABEL = "reference[default]"

@@ -39,7 +39,7 @@ from clearbench.harness.cli.common import (
 from clearbench.harness.measure.headline import format_value
 from clearbench.harness.report.page import write_report
 from clearbench.harness.run.engine_choice import RunInputError
-from clearbench.harness.studies.c60_comparison import PLANS, plan_engines, plan_runs
+from clearbench.harness.studies.c60_comparison import PLAN_NAMES, c60_plan, plan_engines, plan_runs
 
 DEFAULT_REPORT = Path("reports/c60_validation.md")
 DEFAULT_FIGURES = Path("reports/figures")
@@ -82,7 +82,7 @@ def register(subparsers) -> None:
         "`clearbench demo` runs: shortened horizons, a few minutes of CPU) or `full` (the "
         "scenes' horizons and longer ladders: hours).",
     )
-    compare.add_argument("--plan", choices=sorted(PLANS), default="demo",
+    compare.add_argument("--plan", choices=sorted(PLAN_NAMES), default="demo",
                          help="which runs (default demo)")
     add_engine_option(compare, many=True,
                       help="only these labels of the plan (default: every label whose engine "
@@ -205,8 +205,8 @@ def run_angles(args: argparse.Namespace) -> int:
 def run_c60_plan(plan_name: str, labels, modules, args, store) -> set[str]:
     """Validate and run the plan's C-60 runs (``labels``: only these engine labels); print
     the labels left out and why, then the cross-engine figures. Returns the run keys."""
-    plan = PLANS[plan_name]
     try:
+        plan = c60_plan(plan_name, modules)
         engines, left_out = plan_engines(plan, labels, modules)
         specs = plan_runs(plan, engines)
     except RunInputError as error:
@@ -245,6 +245,6 @@ def run_c60_compare(args: argparse.Namespace) -> int:
     modules = engine_modules(args)
     store = open_store(args)
     run_c60_plan(args.plan, args.engines, modules, args, store)
-    paths = write_report(store, args.out)
+    paths = write_report(store, args.out, engine_modules=modules)
     print(f"\nreport: {paths['html']}\nsummary: {paths['markdown']}")
     return 0

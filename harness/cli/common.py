@@ -51,11 +51,17 @@ def add_runner_options(parser: argparse.ArgumentParser, timeout: float = DEFAULT
                         "fresh process per run; a crashed or timed-out worker is always replaced)")
     parser.add_argument("--rerun", action="store_true",
                         help="run again even when the run is already in the store")
-    parser.add_argument("--engine-module", action="append", default=[], metavar="NAME=MODULE",
-                        help="an extra engine adapter module (same contract as "
-                        "clearbench.adapters), e.g. mine=my_package.my_adapter")
+    add_engine_module_option(parser)
     parser.add_argument("--no-progress", action="store_true",
                         help="no progress bar (terminal) nor progress lines (log or pipe)")
+
+
+def add_engine_module_option(parser: argparse.ArgumentParser) -> None:
+    """--engine-module NAME=MODULE (repeatable): an engine plugged in (:func:`engine_modules`)."""
+    parser.add_argument("--engine-module", action="append", default=[], metavar="NAME=MODULE",
+                        help="an extra engine adapter module (same contract as "
+                        "clearbench.adapters, its harness defaults included), e.g. "
+                        "mine=my_package.my_adapter")
 
 
 class _AccumulateEngines(argparse.Action):

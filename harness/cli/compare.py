@@ -19,7 +19,7 @@ from clearbench.harness.cli.scenes import check_round_trip, print_engines
 from clearbench.harness.cli.sweep import print_work_precision
 from clearbench.harness.report.page import write_report
 from clearbench.harness.run.engine_choice import RunInputError, resolve_engine
-from clearbench.harness.studies.c60_comparison import PLANS
+from clearbench.harness.studies.c60_comparison import PLAN_NAMES
 from clearbench.harness.studies.stability import available_engines, plan_stability
 from clearbench.harness.studies.sweep import (
     FINE_FACTOR,
@@ -91,7 +91,7 @@ def add_compare_options(parser: argparse.ArgumentParser) -> None:
                         help=f"time-step ladder (default {COMPARE_LADDER})")
     parser.add_argument("--stability", action="store_true",
                         help="also run the stiff and extreme suite")
-    parser.add_argument("--c60", choices=("none", *sorted(PLANS)), default="demo",
+    parser.add_argument("--c60", choices=("none", *sorted(PLAN_NAMES)), default="demo",
                         help="C-60 runs across engines after the scenes: the `demo` plan "
                         "(default; shortened horizons, a few minutes), `full` (hours) or none")
     parser.add_argument("--out", default="reports/out", metavar="DIR",
@@ -133,7 +133,7 @@ def run_compare(args: argparse.Namespace) -> int:
         print()
         run_c60_plan(args.c60, [e.label for e in engines] if args.engines else None, modules,
                      args, store)
-    paths = write_report(store, args.out)
+    paths = write_report(store, args.out, engine_modules=modules)
     print(f"\nreport: {paths['html']}\nsummary: {paths['markdown']} "
           f"({time.monotonic() - start:.0f} s in all)")
     return 0

@@ -6,7 +6,12 @@ import argparse
 import time
 
 from clearbench.harness.cli.commands import command_help
-from clearbench.harness.cli.common import UserError, engine_modules
+from clearbench.harness.cli.common import (
+    UserError,
+    add_engine_module_option,
+    add_engine_option,
+    engine_modules,
+)
 from clearbench.harness.run.engine_choice import RunInputError
 from clearbench.harness.studies.regress import (
     DEFAULT_BASELINE,
@@ -19,7 +24,13 @@ from clearbench.harness.studies.regress import (
     updated_baseline,
     write_baseline,
 )
-from clearbench.harness.studies.regress.suite import warm_up
+from clearbench.harness.studies.regress.suite import (
+    EngineSelection,
+    engines_without_runs,
+    restricted,
+    warm_up,
+    with_declared_runs,
+)
 
 
 def register(subparsers) -> None:
@@ -44,8 +55,12 @@ def register(subparsers) -> None:
                         help="parallel workers (default: usable cores)")
     parser.add_argument("--runs-per-worker", type=int, default=1, metavar="N",
                         help="runs a worker serves before it is replaced (default 1)")
-    parser.add_argument("--engine-module", action="append", default=[], metavar="NAME=MODULE",
-                        help="an extra engine adapter module, e.g. mine=my_package.adapter")
+    add_engine_option(parser, many=True,
+                      help="only the suite's entries of these engines (ENGINE: all of its "
+                      "entries, ENGINE[PRESET]: that label's); with --update, an engine with no "
+                      "entry yet gets the quick runs it declares (its HARNESS_DEFAULTS) and the "
+                      "other engines' results are kept")
+    add_engine_module_option(parser)
     parser.set_defaults(handler=run_regress)
 
 
@@ -53,11 +68,18 @@ def run_regress(args: argparse.Namespace) -> int:
     start = time.monotonic()
     modules = engine_modules(args)
     try:
-        baseline = load_baseline(args.baseline)
+        chosen = EngineSelection.parse(args.engines, modules) if args.engines else None
+        baseline = load_baseline(args.baseline, chosen.names if chosen else None, modules)
+        if chosen and args.update:
+            baseline, added = with_declared_runs(baseline, chosen.names, modules)
+            for name in added:
+                print(f"{name}: the quick runs it declares added to the suite")
+        part, others = restricted(baseline, chosen)
         skipped: dict[str, str] = {}
-        specs = suite_specs(baseline, modules, skipped)
-        entries = {ident: entry for ident, entry in suite_entries(baseline, modules).items()
+        specs = suite_specs(part, modules, skipped)
+        entries = {ident: entry for ident, entry in suite_entries(part, modules).items()
                    if ident in specs}
+        missing = engines_without_runs(part, chosen.names if chosen else None, modules)
     except RunInputError as error:
         raise UserError(f"{args.baseline}: {error}") from None
     except ValueError as error:
@@ -65,11 +87,14 @@ def run_regress(args: argparse.Namespace) -> int:
     if args.runs_per_worker < 1 or (args.jobs is not None and args.jobs < 1):
         raise UserError("--jobs and --runs-per-worker must be >= 1")
     if args.update:
-        return _update(args, baseline, entries, specs, skipped, modules, start)
+        return _update(args, baseline, entries, specs, skipped, others, modules, start)
+    for name in missing:
+        print(f"note: {name}: no run in the suite (`clearbench regress --update -e {name}` "
+              "adds the quick runs it declares)")
     warm_up(entries, modules)
     results = run_suite(specs, jobs=args.jobs, runs_per_worker=args.runs_per_worker)
     elapsed = time.monotonic() - start
-    outcome = compare(baseline, results, skipped)
+    outcome = compare(part, results, skipped)
     for note in outcome.notes:
         print(f"note: {note}")
     if outcome.regressions:
@@ -82,7 +107,9 @@ def run_regress(args: argparse.Namespace) -> int:
     return 0
 
 
-def _update(args, baseline, entries, specs, skipped, modules, start) -> int:
+def _update(args, baseline, entries, specs, skipped, others, modules, start) -> int:
+    """Measure ``entries`` and write the baseline; the results of the ``skipped`` runs (engine
+    not available) and of the ``others`` (engines not chosen) kept as they were."""
     def announce(label: str, runs: int) -> None:
         print(f"measuring: {runs} runs ({label}), {time.monotonic() - start:.0f} s so far",
               flush=True)
@@ -93,7 +120,8 @@ def _update(args, baseline, entries, specs, skipped, modules, start) -> int:
     results = measured["results"]
     cost = {"runs": measured["runs"], "worker_seconds": measured["worker_seconds"],
             "seconds": measured["seconds"]}
-    write_baseline(args.baseline, updated_baseline(baseline, results, skipped, cost))
+    kept = {**skipped, **dict.fromkeys(others, "engine not chosen")}
+    write_baseline(args.baseline, updated_baseline(baseline, results, kept, cost, modules))
     statuses = ", ".join(f"{i} {r['status']}" for i, r in results.items())
     kinds: dict[str, int] = {}
     for result in results.values():
@@ -104,4 +132,7 @@ def _update(args, baseline, entries, specs, skipped, modules, start) -> int:
     print("figures: " + ", ".join(f"{n} {k}" for k, n in sorted(kinds.items())))
     for ident, why in skipped.items():
         print(f"note: {ident}: not run, its baseline result kept ({why})")
+    if others:
+        print(f"note: {len(others)} runs of the engines not chosen not run, their baseline "
+              "results kept")
     return 0

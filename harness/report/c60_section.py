@@ -53,9 +53,10 @@ class C60Section:
         return not self.runs and not self.cannot_run
 
 
-def build_section(store, frame, figures: bool = True) -> C60Section:
+def build_section(store, frame, figures: bool = True, colours=None) -> C60Section:
     """The section's content from a store and its DataFrame (``frame``): empty when the
-    store holds no run of c60-on or c60-trip."""
+    store holds no run of c60-on or c60-trip. ``colours``: engine name -> declared colour
+    (:func:`.engine_style.engine_colours`)."""
     runs = collect(store, frame)
     if not runs:   # no C-60 run in the store: no section
         return C60Section([], [])
@@ -67,7 +68,7 @@ def build_section(store, frame, figures: bool = True) -> C60Section:
                          {s.quantity: steps_for_target(s) for s in studies if s.points},
                          cannot)
     if figures and studies:
-        section.figure = c60_work_precision_figure(studies)
+        section.figure = c60_work_precision_figure(studies, colours)
     return section
 
 

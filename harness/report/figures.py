@@ -13,6 +13,7 @@ from __future__ import annotations
 import dataclasses
 import io
 import logging
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -45,10 +46,11 @@ def _png(figure) -> bytes:
     return buffer.getvalue()
 
 
-def ladder_line(axes, label: str, x, y, steps) -> None:
+def ladder_line(axes, label: str, x, y, steps, colours: Mapping[str, str] | None = None
+                ) -> None:
     """One engine's ladder on log-log axes in its own style, each point annotated with its
-    step. ``x``, ``y``, ``steps``: (n,) sequences."""
-    style = engine_style(label)
+    step. ``x``, ``y``, ``steps``: (n,) sequences; ``colours``: as :func:`.engine_style`."""
+    style = engine_style(label, colours)
     axes.loglog(x, y, label=label, **style.plot_kwargs())
     for xi, yi, dt in zip(x, y, steps, strict=True):
         axes.annotate(f"{dt:.2g}", (xi, yi), textcoords="offset points", xytext=(4, 3),
@@ -62,8 +64,10 @@ def pareto_circles(axes, x, y) -> None:
                     markeredgecolor="black", label="Pareto front")
 
 
-def work_precision_figure(points, title: str) -> bytes:
-    """``points``: DataFrame from :func:`.sweep.work_precision_points`."""
+def work_precision_figure(points, title: str, colours: Mapping[str, str] | None = None
+                          ) -> bytes:
+    """``points``: DataFrame from :func:`.sweep.work_precision_points`; ``colours``: engine
+    name -> declared colour (:func:`.engine_style.engine_colours`)."""
     plt = _pyplot()
     figure, axes = plt.subplots(figsize=(6.4, 4.2))
     exact = points[points["error"] <= 0]
@@ -72,7 +76,7 @@ def work_precision_figure(points, title: str) -> bytes:
         rows = rows.sort_values("stepping_seconds_per_simulated_second")
         x = rows["stepping_seconds_per_simulated_second"].to_numpy(dtype=float)
         y = rows["error"].to_numpy(dtype=float)
-        ladder_line(axes, label, x, y, rows["time_step"])
+        ladder_line(axes, label, x, y, rows["time_step"], colours)
     front = points[points["pareto"].astype(bool)]
     pareto_circles(axes, front["stepping_seconds_per_simulated_second"], front["error"])
     if len(exact):
@@ -88,10 +92,11 @@ def work_precision_figure(points, title: str) -> bytes:
     return _png(figure)
 
 
-def c60_work_precision_figure(studies) -> bytes | None:
+def c60_work_precision_figure(studies, colours: Mapping[str, str] | None = None
+                              ) -> bytes | None:
     """``studies``: :class:`~clearbench.harness.c60.work_precision.WorkPrecision` list, one
     panel each (relative error against stepping wall time per run [s]); None when no study
-    has a point with a non-zero error."""
+    has a point with a non-zero error. ``colours``: as :func:`work_precision_figure`."""
     drawn = [s for s in studies if any(p.error > 0 for p in s.points)]
     if not drawn:
         return None
@@ -103,7 +108,7 @@ def c60_work_precision_figure(studies) -> bytes | None:
         for label in sorted({p.label for p in points}):
             mine = sorted((p for p in points if p.label == label), key=lambda p: p.wall_seconds)
             ladder_line(axes, label, [p.wall_seconds for p in mine], [p.error for p in mine],
-                        [p.time_step for p in mine])
+                        [p.time_step for p in mine], colours)
         front = [p for p in points if p.on_front]
         pareto_circles(axes, [p.wall_seconds for p in front], [p.error for p in front])
         axes.axhline(0.01, color="grey", linewidth=0.8, linestyle=":")
@@ -152,8 +157,10 @@ def time_series(scene: Scene, trajectory: Trajectory) -> dict[str, np.ndarray]:
     return series
 
 
-def time_series_figure(scene: Scene, runs: dict[str, Trajectory]) -> bytes | None:
-    """One panel per series, one line per engine label; None when nothing can be drawn."""
+def time_series_figure(scene: Scene, runs: dict[str, Trajectory],
+                       colours: Mapping[str, str] | None = None) -> bytes | None:
+    """One panel per series, one line per engine label; None when nothing can be drawn.
+    ``colours``: as :func:`work_precision_figure`."""
     plt = _pyplot()
     data: dict[str, dict[str, tuple]] = {}
     for label, trajectory in runs.items():
@@ -169,7 +176,7 @@ def time_series_figure(scene: Scene, runs: dict[str, Trajectory]) -> bytes | Non
                                 sharex=True, squeeze=False)
     for axis, title in zip(axes[:, 0], panels, strict=True):
         for label, (t, values) in data[title].items():
-            style = engine_style(label)
+            style = engine_style(label, colours)
             axis.plot(t, values, label=label, linewidth=1.0, color=style.colour,
                       linestyle=style.line_style)
         axis.set_ylabel(title, fontsize=8)

@@ -18,6 +18,7 @@ import html
 import json
 import logging
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
@@ -35,6 +36,7 @@ from clearbench.harness.measure.verdicts import VERDICTS, run_verdict, verdict_t
 from clearbench.harness.report.c60_section import C60Section, build_section
 from clearbench.harness.report.c60_section import section_html as c60_engines_html
 from clearbench.harness.report.c60_section import section_markdown as c60_engines_markdown
+from clearbench.harness.report.engine_style import engine_colours
 from clearbench.harness.report.figures import time_series_figure, work_precision_figure
 from clearbench.harness.run.store import ResultsStore
 from clearbench.harness.studies.campaign.report import load_written_sections
@@ -88,8 +90,11 @@ def _representative(rows, scene: Scene | None) -> dict:
     return chosen
 
 
-def collect(store: ResultsStore, figures: bool = True) -> ReportData:
-    """Gather the report's content from ``store`` (figures computed when ``figures``)."""
+def collect(store: ResultsStore, figures: bool = True,
+            colours: Mapping[str, str] | None = None) -> ReportData:
+    """Gather the report's content from ``store`` (figures computed when ``figures``, each
+    engine in its colour: ``colours``, engine name -> declared colour, default the
+    registry's: :func:`.engine_style.engine_colours`)."""
     frame = store.dataframe()
     sections = []
     approximations: dict[str, dict] = {}
@@ -107,20 +112,22 @@ def collect(store: ResultsStore, figures: bool = True) -> ReportData:
             section.notes.append(f"{rows['scene_hash'].nunique()} scene variants share this "
                                  "name (different parameters); they are listed together.")
         if figures:
-            _figures(store, section)
+            _figures(store, section, colours)
         sections.append(section)
     sections.sort(key=lambda s: (s.scene is not None and "stiff" in s.scene.tags, s.name))
     return ReportData(frame, sections, sorted(frame["label"].unique()) if len(frame) else [],
                       approximations, str(store.directory),
                       datetime.now(UTC).isoformat(timespec="seconds"),
-                      c60_engines=build_section(store, frame, figures) if len(frame) else None)
+                      c60_engines=(build_section(store, frame, figures, colours)
+                                   if len(frame) else None))
 
 
-def _figures(store: ResultsStore, section: SceneSection) -> None:
+def _figures(store: ResultsStore, section: SceneSection,
+             colours: Mapping[str, str] | None) -> None:
     points = work_precision_points(section.runs, section.name)
     if np.count_nonzero(points["error"] > 0) >= 2:
         section.figures["Work–precision"] = work_precision_figure(
-            points, f"{section.name}: error against stepping time")
+            points, f"{section.name}: error against stepping time", colours)
     if section.scene is None:
         section.notes.append("scene not in the store: no time-series figure")
         return
@@ -133,7 +140,7 @@ def _figures(store: ResultsStore, section: SceneSection) -> None:
     if not trajectories:
         return
     try:
-        image = time_series_figure(section.scene, trajectories)
+        image = time_series_figure(section.scene, trajectories, colours)
     except Exception as error:  # a figure must never stop the report
         LOG.warning("no time-series figure for %s: %s", section.name, error)
         section.notes.append(f"drift figure not drawn: {type(error).__name__}: {error}")
@@ -534,16 +541,19 @@ CAMPAIGNS = Path("reports/campaigns")
 
 def write_report(store: ResultsStore, out_dir: str | Path,
                  c60_validation: str | Path | None = C60_VALIDATION,
-                 campaigns: str | Path | None = CAMPAIGNS) -> dict[str, Path]:
+                 campaigns: str | Path | None = CAMPAIGNS,
+                 engine_modules: Mapping[str, str] | None = None) -> dict[str, Path]:
     """Write ``report.html``, ``summary.md`` and ``figures/*.png`` into ``out_dir``.
 
     ``c60_validation``: the JSON of ``clearbench c60 validate``; when it exists the report has
     a section with the C-60 table against the paper and its force-displacement figures.
     ``campaigns``: the folder of ``clearbench campaign report``; each campaign written there
-    gets its tolerance section (statistics beside the paper's, histograms, sensitivities)."""
+    gets its tolerance section (statistics beside the paper's, histograms, sensitivities).
+    ``engine_modules``: engines plugged in (``--engine-module``), whose declared colours the
+    figures use."""
     out = Path(out_dir)
     (out / "figures").mkdir(parents=True, exist_ok=True)
-    data = collect(store)
+    data = collect(store, colours=engine_colours(engine_modules))
     data.c60_validation = load_c60_validation(c60_validation)
     if campaigns is not None and Path(campaigns).is_dir():
         data.campaigns = load_written_sections(campaigns)

@@ -17,6 +17,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 from clearbench.adapters import ENGINES, engine_availability
+from clearbench.adapters.harness_defaults import HarnessDefaults, declared_defaults
 from clearbench.adapters.options import OptionError
 
 _LABEL = re.compile(r"^\s*([A-Za-z0-9_.-]+)\s*(?:\[\s*([A-Za-z0-9_.+-]*)\s*\])?\s*$")
@@ -66,6 +67,31 @@ def engine_module_path(name: str, extra_modules: Mapping[str, str] | None = None
         return ENGINES[name]
     known = sorted(set(ENGINES) | set(extra_modules or {}))
     raise RunInputError("engine", name, f"unknown engine; engines: {', '.join(known)}")
+
+
+def engine_names(extra_modules: Mapping[str, str] | None = None) -> list[str]:
+    """Every engine of :data:`~clearbench.adapters.ENGINES`, then those of ``extra_modules``
+    (a name in both is the extra module's), in that order."""
+    return list(dict.fromkeys([*ENGINES, *(extra_modules or {})]))
+
+
+def engine_defaults(name: str, extra_modules: Mapping[str, str] | None = None
+                    ) -> HarnessDefaults:
+    """What engine ``name`` declares to the harness (its module's ``HARNESS_DEFAULTS``,
+    :mod:`clearbench.adapters.harness_defaults`); imports the adapter's subpackage or module,
+    which imports neither its engine modules nor the engine's package.
+
+    Raises
+    ------
+    RunInputError
+        Unknown engine, or a module that fails to load or declares something else.
+    """
+    module_path = engine_module_path(name, extra_modules)
+    try:
+        return declared_defaults(importlib.import_module(module_path))
+    except Exception as error:  # a plug-in that cannot even load is bad input
+        raise RunInputError("engine", name,
+                            f"adapter {module_path} failed to load: {error}") from None
 
 
 def resolve_engine(text: str, extra_modules: Mapping[str, str] | None = None,

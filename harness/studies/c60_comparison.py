@@ -1,5 +1,7 @@
 """The C-60 across engines: which runs of ``c60-on`` and ``c60-trip`` each engine and preset
-makes (a ladder of time steps per engine, for the work-precision study), in two plans:
+makes (a ladder of time steps per engine, for the work-precision study, as each engine
+declares it: ``HARNESS_DEFAULTS.c60_ladders``, :mod:`clearbench.adapters.harness_defaults`), in
+two plans:
 
 - ``demo``: what ``clearbench demo`` runs, budgeted to a few minutes of CPU on a 2-core
   machine: horizons shortened to 4 ms (c60-on: the mechanism is settled from 3 ms and FC-1 is
@@ -21,7 +23,13 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from clearbench.harness.c60.cross_engine import ON_SCENE, TRIP_SCENE
-from clearbench.harness.run.engine_choice import EngineChoice, RunInputError, resolve_engine
+from clearbench.harness.run.engine_choice import (
+    EngineChoice,
+    RunInputError,
+    engine_defaults,
+    engine_names,
+    resolve_engine,
+)
 from clearbench.harness.run.spec import RunSpec, make_run_spec
 
 #: Samples are recorded about every SAMPLE_SPACING ms whatever the step: trip events are
@@ -44,41 +52,45 @@ class C60Plan:
         return list(dict.fromkeys(label for ladder in self.ladders.values() for label in ladder))
 
 
-DEMO = C60Plan(
-    "demo",
-    "c60-on to 4 ms and c60-trip to 8.5 ms (shortened for the demo); the reference at 1 us "
-    "is the fine run every error is measured against",
-    {ON_SCENE: 4.0, TRIP_SCENE: 8.5},
-    {ON_SCENE: {"reference[default]": (1e-3, 4e-3),
-                "mujoco[default]": (1e-3,),
-                "mujoco[tuned]": (1e-3, 2e-3, 4e-3, 8e-3),
-                "pybullet[tuned]": (2e-3, 4e-3),
-                "siconos[default]": (1e-2,),
-                "siconos[projection]": (1e-2,),
-                "exudyn[mechanism]": (1e-3,)},
-     TRIP_SCENE: {"reference[default]": (1e-3,),
-                  "mujoco[tuned]": (1e-3, 4e-3)}},
-    timeout=1800.0)
+#: The plans, each as (description, scene -> horizon [ms], timeout [s]); their ladders are
+#: what each engine declares for them (``HARNESS_DEFAULTS.c60_ladders``, :func:`c60_plan`).
+PLAN_SETTINGS = {
+    "demo": ("c60-on to 4 ms and c60-trip to 8.5 ms (shortened for the demo); the reference at "
+             "1 us is the fine run every error is measured against",
+             {ON_SCENE: 4.0, TRIP_SCENE: 8.5}, 1800.0),
+    "full": ("c60-on (7 ms) and c60-trip (20 ms) at the scenes' own horizons; the reference at "
+             "0.5 us is the fine run every error is measured against",
+             {ON_SCENE: 7.0, TRIP_SCENE: 20.0}, 7200.0),
+}
+PLAN_NAMES = tuple(PLAN_SETTINGS)
 
-FULL = C60Plan(
-    "full",
-    "c60-on (7 ms) and c60-trip (20 ms) at the scenes' own horizons; the reference at 0.5 us "
-    "is the fine run every error is measured against",
-    {ON_SCENE: 7.0, TRIP_SCENE: 20.0},
-    {scene: {"reference[default]": (5e-4, 1e-3, 2e-3, 4e-3),
-             "mujoco[default]": (1e-3, 4e-3),
-             "mujoco[tuned]": (1e-3, 2e-3, 4e-3, 8e-3),
-             "pybullet[default]": (1e-3,),
-             "pybullet[tuned]": (1e-3, 2e-3, 4e-3),
-             "siconos[default]": (1e-3, 2e-3, 1e-2),
-             "siconos[nsn-ac]": (1e-3,),
-             "siconos[projection]": (1e-3,),
-             "exudyn[default]": (1e-3,),
-             "exudyn[tuned]": (1e-3,),
-             "exudyn[mechanism]": (1e-3,)} for scene in (ON_SCENE, TRIP_SCENE)},
-    timeout=7200.0)
 
-PLANS = {plan.name: plan for plan in (DEMO, FULL)}
+def c60_plan(name: str, extra_modules: Mapping[str, str] | None = None) -> C60Plan:
+    """Plan ``name`` (:data:`PLAN_NAMES`) with the ladders every engine of the registry and
+    of ``extra_modules`` declares for it, in that order of engines and each engine's order of
+    presets.
+
+    Raises
+    ------
+    RunInputError
+        An engine module that fails to load, or a ladder declared for a plan or a scene the
+        harness does not have.
+    """
+    description, horizons, timeout = PLAN_SETTINGS[name]
+    ladders: dict[str, dict[str, tuple[float, ...]]] = {scene: {} for scene in horizons}
+    for engine in engine_names(extra_modules):
+        declared = engine_defaults(engine, extra_modules).c60_ladders
+        for plan_name, scenes in declared.items():
+            for scene, ladder in scenes.items():
+                if plan_name not in PLAN_SETTINGS or scene not in horizons:
+                    raise RunInputError(f"{engine} HARNESS_DEFAULTS.c60_ladders",
+                                        f"{plan_name}/{scene}",
+                                        f"plans: {', '.join(PLAN_NAMES)}; scenes: "
+                                        f"{', '.join(horizons)}")
+                if plan_name == name:
+                    ladders[scene].update({f"{engine}[{preset}]": tuple(map(float, steps))
+                                           for preset, steps in ladder.items()})
+    return C60Plan(name, description, horizons, ladders, timeout)
 
 
 def record_every(time_step: float) -> int:
@@ -110,12 +122,20 @@ def plan_runs(plan: C60Plan, engines: Sequence[EngineChoice],
 def plan_engines(plan: C60Plan, labels: Sequence[str] | None = None,
                  extra_modules: Mapping[str, str] | None = None
                  ) -> tuple[list[EngineChoice], dict[str, str]]:
-    """The plan's engine labels (or ``labels``) resolved, and label -> why not, for those
-    that cannot run here (engine not available, preset refused)."""
+    """The plan's engine labels (or those of ``labels`` it has a ladder for) resolved, and
+    label -> why not, for those that cannot run here (engine not available, preset refused,
+    no ladder declared in the plan)."""
     chosen, left_out = [], {}
-    for label in labels if labels is not None else plan.labels():
+    planned = plan.labels()
+    for label in labels if labels is not None else planned:
         try:
-            chosen.append(resolve_engine(label, extra_modules))
+            choice = resolve_engine(label, extra_modules)
         except RunInputError as error:
             left_out[label] = error.reason
+            continue
+        if choice.label in planned:
+            chosen.append(choice)
+        else:
+            left_out[label] = (f"no ladder in the {plan.name} plan (the engine declares its "
+                               "C-60 ladders: HARNESS_DEFAULTS.c60_ladders)")
     return chosen, left_out

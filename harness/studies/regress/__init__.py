@@ -1,7 +1,8 @@
 """Regression check: a quick suite compared with a committed baseline whose tolerances are
 measured, not chosen.
 
-- :mod:`.suite`: the suite's runs, their specs, running them;
+- :mod:`.suite`: the suite's runs (a new baseline's: what each engine declares), their specs,
+  running them;
 - :mod:`.perturbations`: the perturbations that carry no physics (round-off of the initial
   state, numba and OpenBLAS code paths, an engine's own arithmetic settings);
 - :mod:`.tolerance`: the tolerance model (exact, bounded, statistical figures; floors);
@@ -12,21 +13,21 @@ measured, not chosen.
 from clearbench.harness.studies.regress.baseline import (
     DEFAULT_BASELINE,
     load_baseline,
+    new_baseline,
     updated_baseline,
     write_baseline,
 )
 from clearbench.harness.studies.regress.compare import RegressOutcome, compare, version_note
 from clearbench.harness.studies.regress.measure import measure_baseline
 from clearbench.harness.studies.regress.suite import (
-    DEFAULT_SUITE,
-    ENGINE_PRESETS,
+    default_suite,
     run_suite,
     suite_entries,
     suite_specs,
 )
 from clearbench.harness.studies.regress.tolerance import Check, classify
 
-__all__ = ["DEFAULT_BASELINE", "DEFAULT_SUITE", "ENGINE_PRESETS", "Check", "RegressOutcome",
-           "classify", "compare", "load_baseline", "measure_baseline", "run_suite",
+__all__ = ["DEFAULT_BASELINE", "Check", "RegressOutcome", "classify", "compare",
+           "default_suite", "load_baseline", "measure_baseline", "new_baseline", "run_suite",
            "suite_entries", "suite_specs", "updated_baseline", "version_note",
            "write_baseline"]

@@ -16,37 +16,52 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from datetime import UTC, datetime
 from pathlib import Path
 
-from clearbench.harness.run.engine_choice import RunInputError
+from clearbench.harness.run.engine_choice import RunInputError, engine_defaults, engine_names
 from clearbench.harness.run.store import machine_info, revision_info
 from clearbench.harness.studies.regress import tolerance
 from clearbench.harness.studies.regress.perturbations import (
-    DEFAULT_PERTURBATIONS,
     check_perturbations,
+    default_perturbations,
 )
-from clearbench.harness.studies.regress.suite import DEFAULT_SUITE
+from clearbench.harness.studies.regress.suite import default_suite
 
 DEFAULT_BASELINE = Path("reports/baselines/quick.json")
 
 
-def tolerance_model() -> dict:
-    """The constants of the tolerance model (:mod:`.tolerance`), as written in a baseline."""
+def tolerance_model(extra_modules: Mapping[str, str] | None = None) -> dict:
+    """The constants of the tolerance model (:mod:`.tolerance`), as written in a baseline, and
+    the engines (of the registry and ``extra_modules``) that declare rigid contacts."""
+    rigid = [name for name in engine_names(extra_modules)
+             if engine_defaults(name, extra_modules).rigid_contacts]
     return {"exact_widen": tolerance.EXACT_WIDEN,
             "statistical_spread": tolerance.STATISTICAL_SPREAD,
             "floor_relative": tolerance.FLOOR_RELATIVE,
             "bound_headroom": tolerance.BOUND_HEADROOM,
             "ensemble_widen": tolerance.ENSEMBLE_WIDEN,
             "count_floor": [tolerance.COUNT_FLOOR_RELATIVE, tolerance.COUNT_FLOOR_ABSOLUTE],
-            "rigid_engines": list(tolerance.RIGID_ENGINES),
+            "rigid_engines": rigid,
             "why": "see docs/harness.md#regression and harness/studies/regress/tolerance.py"}
 
 
-def load_baseline(path: str | Path) -> dict:
-    """The baseline at ``path`` (a new one with the default suite and perturbations when the
-    file does not exist).
+def new_baseline(engines: Sequence[str] | None = None,
+                 extra_modules: Mapping[str, str] | None = None) -> dict:
+    """A baseline without results: the quick runs and perturbations the engines declare
+    (:func:`.suite.default_suite`, :func:`.perturbations.default_perturbations`) for
+    ``engines`` (names; default every engine of the registry and of ``extra_modules``)."""
+    return {"description": "Quick regression suite of clearbench: every engine on a few "
+            "smoke scenes with short horizons, and a short c60-on each.",
+            "suite": default_suite(engines, extra_modules),
+            "perturbations": default_perturbations(engines, extra_modules), "results": {}}
+
+
+def load_baseline(path: str | Path, engines: Sequence[str] | None = None,
+                  extra_modules: Mapping[str, str] | None = None) -> dict:
+    """The baseline at ``path`` (:func:`new_baseline` of ``engines`` when the file does not
+    exist).
 
     Raises
     ------
@@ -55,14 +70,11 @@ def load_baseline(path: str | Path) -> dict:
     """
     path = Path(path)
     if not path.exists():
-        return {"description": "Quick regression suite of clearbench: every engine on a few "
-                "smoke scenes with short horizons, and a short c60-on each.",
-                "suite": DEFAULT_SUITE, "perturbations": DEFAULT_PERTURBATIONS,
-                "results": {}}
+        return new_baseline(engines, extra_modules)
     data = json.loads(path.read_text())
     if "suite" not in data:
         raise RunInputError(f"{path}: suite", None, "missing from the baseline file")
-    data.setdefault("perturbations", DEFAULT_PERTURBATIONS)
+    data.setdefault("perturbations", default_perturbations(extra_modules=extra_modules))
     try:
         check_perturbations(data["perturbations"])
     except ValueError as error:
@@ -90,13 +102,15 @@ def _plain(value):
 
 def updated_baseline(baseline: dict, results: dict[str, dict],
                      skipped: Mapping[str, str] | None = None,
-                     cost: Mapping[str, float] | None = None) -> dict:
+                     cost: Mapping[str, float] | None = None,
+                     extra_modules: Mapping[str, str] | None = None) -> dict:
     """The baseline with ``results`` (each with its ``checks``), ``tolerance_model`` and
     ``recorded`` replaced (the results of ``skipped`` runs, whose engine is not available
-    here, kept as they were); ``cost``: runs, worker seconds and seconds of the measurement."""
+    here or was not chosen, kept as they were); ``cost``: runs, worker seconds and seconds of
+    the measurement."""
     new = {key: value for key, value in baseline.items() if key != "tolerances"}
-    new.setdefault("perturbations", DEFAULT_PERTURBATIONS)
-    new["tolerance_model"] = tolerance_model()
+    new.setdefault("perturbations", default_perturbations(extra_modules=extra_modules))
+    new["tolerance_model"] = tolerance_model(extra_modules)
     kept = {ident: old for ident, old in baseline.get("results", {}).items()
             if ident in (skipped or {})}
     new["results"] = {**kept, **{ident: _stored(r) for ident, r in results.items()}}

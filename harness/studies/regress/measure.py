@@ -3,8 +3,8 @@ of every figure from the spread (``clearbench regress --update``).
 
 Cost: one run per entry, plus per entry its round-off seeds (2, or its ``ensemble``: 8 for
 the compliant engines' C-60 runs), plus one run per environment perturbation for the entries
-of the engines the environment reaches (:data:`ENVIRONMENT_ENGINES`) and one per option
-perturbation of its engine; an entry that turns out to have a statistical figure gets more
+(every engine: see :func:`planned_variants`) and one per option perturbation of its
+engine; an entry that turns out to have a statistical figure gets more
 round-off seeds, up to :data:`ENSEMBLE_SIZE`. About 190 runs for the default suite against 22
 for a check (130 were measured with one environment perturbation on the reference only).
 """
@@ -15,6 +15,7 @@ import math
 import time
 from collections.abc import Callable, Mapping
 
+from clearbench.harness.run.engine_choice import engine_defaults
 from clearbench.harness.run.spec import RunSpec
 from clearbench.harness.studies.regress.perturbations import (
     Variant,
@@ -24,12 +25,6 @@ from clearbench.harness.studies.regress.perturbations import (
 from clearbench.harness.studies.regress.suite import engine_name, entry_spec, run_suite, warm_up
 from clearbench.harness.studies.regress.tolerance import classify, figure_scale
 
-#: Engines whose runs the environment perturbations (numba, OpenBLAS) are applied to: every
-#: engine. Besides the reference solver's numba kernels and the harness's measuring code, the
-#: adapters prepare every engine's input with numpy (OpenBLAS), and a chaotic run amplifies
-#: that round-off: PyBullet's C-60 penetration came out at 0.68 um under
-#: OPENBLAS_CORETYPE=Prescott, outside the range 0.98..1.18 um of 8 round-off seeds.
-ENVIRONMENT_ENGINES = ("reference", "mujoco", "pybullet", "exudyn", "siconos")
 #: Round-off seeds of an entry with a statistical figure (its ensemble; tolerance.py).
 ENSEMBLE_SIZE = 8
 #: Statuses of a perturbed run that are not accepted as statuses of the entry: an engine that
@@ -41,14 +36,13 @@ ENGINE_FAILURES = ("crashed", "timed_out")
 
 def planned_variants(entries: Mapping[str, dict], perturbations: list[dict]
                      ) -> dict[str, list[Variant]]:
-    """Run id -> its perturbed reruns (environment perturbations only for the engines of
-    :data:`ENVIRONMENT_ENGINES`)."""
-    plan = {}
-    for ident, entry in entries.items():
-        engine = engine_name(entry.get("engine"))
-        plan[ident] = [v for v in variants_for(entry, engine, perturbations)
-                       if not v.environment or engine in ENVIRONMENT_ENGINES]
-    return plan
+    """Run id -> its perturbed reruns. The environment perturbations (numba, OpenBLAS) apply
+    to every engine: besides the reference solver's numba kernels and the harness's measuring
+    code, the adapters prepare every engine's input with numpy (OpenBLAS), and a chaotic run
+    amplifies that round-off: PyBullet's C-60 penetration came out at 0.68 um under
+    OPENBLAS_CORETYPE=Prescott, outside the range 0.98..1.18 um of 8 round-off seeds."""
+    return {ident: variants_for(entry, engine_name(entry.get("engine")), perturbations)
+            for ident, entry in entries.items()}
 
 
 def variant_spec(entry: dict, ident: str, variant: Variant,
@@ -120,17 +114,19 @@ def _value(metrics: dict, name: str) -> float | None:
     return math.nan if value is None else float(value)
 
 
-def checks_of(entry_spec_: RunSpec, base: dict, perturbed: Mapping[str, dict]) -> dict:
+def checks_of(entry_spec_: RunSpec, base: dict, perturbed: Mapping[str, dict],
+              extra_modules: Mapping[str, str] | None = None) -> dict:
     """Figure name -> :class:`~.tolerance.Check` (as dicts) of one run from its unperturbed
-    result ``base`` and its perturbed results (variant name -> result)."""
-    engine = engine_name(base.get("engine"))
+    result ``base`` and its perturbed results (variant name -> result); rigid or compliant as
+    its engine declares (``HARNESS_DEFAULTS.rigid_contacts``)."""
+    rigid = engine_defaults(engine_name(base.get("engine")), extra_modules).rigid_contacts
     checks = {}
     for name in sorted(base["metrics"]):
         base_value = _value(base["metrics"], name)
         values = [v for v in (_value(r["metrics"], name) for r in perturbed.values())
                   if v is not None]
         scale = figure_scale(name, entry_spec_.scene, entry_spec_.horizon, base["metrics"])
-        checks[name] = classify(name, engine, base_value, values, scale).to_dict()
+        checks[name] = classify(name, rigid, base_value, values, scale).to_dict()
     return checks
 
 
@@ -154,14 +150,15 @@ def measure_baseline(entries: Mapping[str, dict], specs: Mapping[str, RunSpec],
     results = run_suite(specs, jobs=jobs, runs_per_worker=runs_per_worker)
     plan = planned_variants(entries, perturbations)
     perturbed = run_perturbed(entries, plan, extra_modules, jobs, runs_per_worker, on_group)
-    checks = {ident: checks_of(specs[ident], result, perturbed[ident])
+    checks = {ident: checks_of(specs[ident], result, perturbed[ident], extra_modules)
               for ident, result in results.items()}
     extra = _ensemble_extension(plan, checks, perturbations)
     if extra:
         more = run_perturbed(entries, extra, extra_modules, jobs, runs_per_worker, on_group)
         for ident, ran in more.items():
             perturbed[ident].update(ran)
-            checks[ident] = checks_of(specs[ident], results[ident], perturbed[ident])
+            checks[ident] = checks_of(specs[ident], results[ident], perturbed[ident],
+                                      extra_modules)
     runs = len(results) + sum(len(v) for v in perturbed.values())
     worker_seconds = sum(r.get("worker_seconds", 0.0) for r in results.values()) + sum(
         r.get("worker_seconds", 0.0) for v in perturbed.values() for r in v.values())

@@ -14,10 +14,12 @@ depend on beyond round-off, and that differs between machines of our kind:
   reassociation or vectorisation), ``OPENBLAS_CORETYPE=Prescott`` (OpenBLAS's SSE3 kernels
   instead of the host's AVX ones: what another CPU picks at run time). numba caches each in a
   directory of its own (:func:`clearbench.numba_cache_dir`), so the code really is recompiled.
-- ``options``: an engine's own setting that changes only its arithmetic: Exudyn's sparse
-  linear solver instead of the dense one (another factorisation order). MuJoCo, PyBullet and
-  the Siconos worker expose no thread or SIMD setting (MuJoCo steps single-threaded; the
-  Siconos worker runs with one OpenMP thread), so they are perturbed by the first two only.
+- ``options``: an engine's own setting that changes only its arithmetic, as the engine
+  declares it (``HARNESS_DEFAULTS.perturbations``,
+  :mod:`clearbench.adapters.harness_defaults`): Exudyn's sparse linear solver instead of the
+  dense one (another factorisation order). MuJoCo, PyBullet and the Siconos worker expose no
+  thread or SIMD setting (MuJoCo steps single-threaded; the Siconos worker runs with one
+  OpenMP thread), so they are perturbed by the first two only.
 
 A perturbation is a plain dict in the baseline (``perturbations``), so the set is stated where
 the tolerances measured from it are.
@@ -26,9 +28,11 @@ the tolerances measured from it are.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
+from clearbench.harness.run.engine_choice import engine_defaults, engine_names
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.scene import Scene
 
@@ -39,8 +43,9 @@ ROUNDOFF_ULPS = 4
 #: Round-off perturbations of an entry without an ``ensemble`` of its own.
 ROUNDOFF_SEEDS = 2
 
-#: The perturbations written into a new baseline.
-DEFAULT_PERTURBATIONS = [
+#: The perturbations of every engine written into a new baseline (with the engines' own,
+#: :func:`default_perturbations`).
+GENERIC_PERTURBATIONS = [
     {"name": "roundoff", "kind": "roundoff", "ulps": ROUNDOFF_ULPS, "seeds": ROUNDOFF_SEEDS,
      "why": "initial state of every moving body times (1 + k eps), |k| <= ulps, seeded: one "
      "rounding of the input (an entry's 'ensemble' sets its number of seeds)"},
@@ -53,10 +58,19 @@ DEFAULT_PERTURBATIONS = [
     {"name": "openblas-prescott", "kind": "environment",
      "environment": {"OPENBLAS_CORETYPE": "Prescott"},
      "why": "OpenBLAS's SSE3 kernels instead of the host's: the BLAS another CPU picks"},
-    {"name": "exudyn-sparse", "kind": "options", "engines": ["exudyn"],
-     "options": {"linear_solver": "EigenSparse"},
-     "why": "Exudyn's sparse LU instead of its dense one: another factorisation order"},
 ]
+
+
+def default_perturbations(engines: Sequence[str] | None = None,
+                          extra_modules: Mapping[str, str] | None = None) -> list[dict]:
+    """The perturbations of a new baseline: :data:`GENERIC_PERTURBATIONS`, then the option
+    perturbations each engine declares (``HARNESS_DEFAULTS.perturbations``) for ``engines``
+    (names; default: every engine of the registry and of ``extra_modules``)."""
+    names = engine_names(extra_modules) if engines is None else engines
+    own = [{"name": p.name, "kind": "options", "engines": [name], "options": dict(p.options),
+            "why": p.why}
+           for name in names for p in engine_defaults(name, extra_modules).perturbations]
+    return [dict(p) for p in GENERIC_PERTURBATIONS] + own
 
 
 @dataclasses.dataclass(frozen=True)

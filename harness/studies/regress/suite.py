@@ -5,77 +5,45 @@ A suite entry is a plain dict: ``id``, ``scene`` (registered name or scene file)
 parameters, as ``--set``), ``time_step``, ``horizon``, ``record_every``, ``options``,
 ``timeout`` [s] and ``ensemble`` (the number of round-off perturbations its tolerances are
 measured from, :mod:`.perturbations`; default :data:`.perturbations.ROUNDOFF_SEEDS`).
+The suite of a new baseline is what the engines declare (:func:`default_suite`).
 """
 
 from __future__ import annotations
 
 import json
 import tempfile
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 from clearbench.adapters import ENGINES, engine_availability
-from clearbench.harness.run.engine_choice import RunInputError, parse_engine_label
+from clearbench.harness.run.engine_choice import (
+    RunInputError,
+    engine_defaults,
+    engine_module_path,
+    engine_names,
+    parse_engine_label,
+)
 from clearbench.harness.run.runner import Runner
 from clearbench.harness.run.spec import RunSpec, make_run_spec, resolve_scene
 from clearbench.harness.run.store import ResultsStore
 
-#: Suite of the reference engine (smoke scenes, short horizons). Each entry also carries the
-#: deliberate physics changes it must catch (tests/test_regress_catches.py): the bounce apexes
-#: and rest time move with the restitution, the sliding box's stop with the friction (0.8 s
-#: covers its stop at v0 / (mu g) = 0.68 s), the clearance pendulum's eccentricity with the
-#: clearance.
-REFERENCE_SUITE = [
-    {"id": "bouncing-ball-e0.5", "scene": "bouncing-ball-e0.5", "engine": "reference",
-     "horizon": 1.0},
-    {"id": "incline-stick", "scene": "incline-stick", "engine": "reference", "horizon": 0.3},
-    {"id": "sliding-box", "scene": "sliding-box", "engine": "reference", "horizon": 0.8},
-    {"id": "pendulum", "scene": "pendulum", "engine": "reference", "horizon": 1.0},
-    # 0.1 s: covers the first impacts in the clearance, before the rattling motion amplifies
-    # round-off into a spread of a whole clearance (DESIGN.md: 1e-4 m on long runs).
-    {"id": "clearance-pendulum", "scene": "clearance-pendulum", "engine": "reference",
-     "horizon": 0.1},
-]
 
-#: Quick scenes every other engine runs (scene, horizon [s]): a bounce (restitution, contact),
-#: stick on an incline (friction) and a pendulum (an ideal joint).
-ENGINE_SCENES = (("bouncing-ball-e0.5", 1.0), ("incline-stick", 0.3), ("pendulum", 1.0))
-#: The preset each other engine is checked in (the one the docs measure the C-60 with).
-ENGINE_PRESETS = {"mujoco": "tuned", "pybullet": "tuned", "exudyn": "tuned",
-                  "siconos": "default"}
-#: The preset each engine runs the short c60-on in, where it is not its ENGINE_PRESETS one: the
-#: preset the C-60 plans use (Exudyn's 'mechanism', docs/engines/exudyn.md).
-C60_PRESETS = {"exudyn": "mechanism"}
-#: The short c60-on of each engine: (horizon [ms], step [ms]). 0.2 ms covers the first settling
-#: impacts of the joints; Exudyn costs about 35 ms per step on the C-60, so 0.03 ms (before
-#: the first clearance closes, about 10 s); Siconos steps 10 us (36 ms of wall time per 1 us
-#: step).
-C60_SHORT = {"reference": (0.2, 1e-3), "mujoco": (0.2, 1e-3), "pybullet": (0.2, 1e-3),
-             "exudyn": (0.03, 1e-3), "siconos": (0.2, 1e-2)}
-#: Round-off perturbations of the C-60 runs of the compliant engines, whose impacts amplify
-#: round-off into figures that are draws from a distribution (penetration, FC figures): an
-#: ensemble of 8 gives the range a new value is judged against (tolerance.py).
-C60_ENSEMBLE = {"mujoco": 8, "pybullet": 8, "exudyn": 8}
+def default_suite(engines: Sequence[str] | None = None,
+                  extra_modules: Mapping[str, str] | None = None) -> list[dict]:
+    """The suite of a new baseline: the quick runs each engine declares
+    (``HARNESS_DEFAULTS.regress_runs``, :mod:`clearbench.adapters.harness_defaults`), for
+    ``engines`` (names; default: every engine of the registry and of ``extra_modules``), in
+    that order.
 
-
-def _engine_suite() -> list[dict]:
-    suite = []
-    for name, preset in ENGINE_PRESETS.items():
-        label = f"{name}[{preset}]"
-        suite += [{"id": f"{label} {scene}", "scene": scene, "engine": label,
-                   "horizon": horizon} for scene, horizon in ENGINE_SCENES]
-    for name, (horizon, step) in C60_SHORT.items():
-        label = f"{name}[{C60_PRESETS.get(name) or ENGINE_PRESETS.get(name, 'default')}]"
-        entry = {"id": f"{label} c60-on", "scene": "c60-on", "engine": label,
-                 "parameters": {"horizon": horizon}, "time_step": step, "record_every": 10}
-        if name in C60_ENSEMBLE:
-            entry["ensemble"] = C60_ENSEMBLE[name]
-        suite.append(entry)
-    return suite
-
-
-#: Suite written into a new baseline.
-DEFAULT_SUITE = REFERENCE_SUITE + _engine_suite()
+    Raises
+    ------
+    RunInputError
+        An unknown engine, or a module that fails to load.
+    """
+    names = engine_names(extra_modules) if engines is None else engines
+    return [entry for name in names
+            for entry in engine_defaults(name, extra_modules).regress_entries(name)]
 
 
 def entry_spec(entry: dict, ident: str, extra_modules: Mapping[str, str] | None = None,
@@ -150,6 +118,67 @@ def engine_name(label: str | None) -> str:
     return str(label or "reference").split("[", 1)[0]
 
 
+@dataclass(frozen=True)
+class EngineSelection:
+    """The engines ``clearbench regress -e`` names: ``ENGINE`` takes every entry of the engine,
+    ``ENGINE[PRESET]`` the entries of that label only."""
+
+    labels: tuple[str, ...]
+
+    @classmethod
+    def parse(cls, labels: Sequence[str], extra_modules: Mapping[str, str] | None = None
+              ) -> EngineSelection:
+        """RunInputError naming a label that is malformed or names no engine."""
+        for label in labels:
+            name, _ = parse_engine_label(label, "--engines")
+            engine_module_path(name, extra_modules)
+        return cls(tuple(labels))
+
+    @property
+    def names(self) -> list[str]:
+        return list(dict.fromkeys(engine_name(label) for label in self.labels))
+
+    def takes(self, entry: dict) -> bool:
+        """Whether the suite entry ``entry`` runs an engine of the selection."""
+        name, preset = parse_engine_label(entry.get("engine", "reference"))
+        return any(parse_engine_label(label) == (name, preset) if "[" in label
+                   else engine_name(label) == name for label in self.labels)
+
+
+def with_declared_runs(baseline: dict, engines: Sequence[str],
+                       extra_modules: Mapping[str, str] | None = None) -> tuple[dict, list[str]]:
+    """``baseline`` with the quick runs each of ``engines`` (names) declares appended to its
+    suite, for those that have no entry in it yet; and the names that got them. This is how a
+    new engine's runs enter a committed baseline (``clearbench regress --update -e NAME``)."""
+    added = engines_without_runs(baseline, engines, extra_modules)
+    if not added:
+        return baseline, []
+    return {**baseline, "suite": [*baseline["suite"], *default_suite(added, extra_modules)]}, \
+        added
+
+
+def engines_without_runs(baseline: dict, engines: Sequence[str] | None = None,
+                         extra_modules: Mapping[str, str] | None = None) -> list[str]:
+    """Those of ``engines`` (names; default: every engine of the registry and of
+    ``extra_modules``) that have no entry in the suite."""
+    present = {engine_name(entry.get("engine")) for entry in baseline["suite"]}
+    return [name for name in (engine_names(extra_modules) if engines is None else engines)
+            if name not in present]
+
+
+def restricted(baseline: dict, selection: EngineSelection | None) -> tuple[dict, list[str]]:
+    """The baseline with its suite and results restricted to the entries of ``selection``
+    (all when None), and the ids of the entries left out."""
+    if selection is None:
+        return baseline, []
+    taken = [entry for entry in baseline["suite"] if selection.takes(entry)]
+    others = [entry.get("id") for entry in baseline["suite"] if not selection.takes(entry)]
+    ids = {entry.get("id") for entry in taken}
+    return {**baseline, "suite": taken,
+            "results": {i: r for i, r in baseline.get("results", {}).items() if i in ids}}, \
+        others
+
+
 def _result_of(row: dict) -> dict:
     passed = row["expectations_passed"]
     return {"status": row["status"], "scene_hash": row["scene_hash"],
@@ -164,19 +193,19 @@ def _result_of(row: dict) -> dict:
 #: Wall-clock limit of a warm-up run [s]: it may compile every numba kernel of the reference
 #: solver and of the measuring code from an empty cache (minutes on a loaded 2-core machine).
 WARM_UP_TIMEOUT = 3600.0
-#: Engines whose runs compile numba kernels (the measuring code's are compiled by them too).
-NUMBA_ENGINES = ("reference",)
 
 
 def warm_up_specs(entries: Mapping[str, dict],
                   extra_modules: Mapping[str, str] | None = None) -> list[RunSpec]:
-    """One run of two steps per distinct scene of the entries of :data:`NUMBA_ENGINES`, with a
-    long wall-clock limit: run one after the other before a suite, they fill numba's cache,
-    so that the suite's runs (each in a fresh worker, with the entry's own limit) do not all
-    compile the same kernels at once from an empty cache and time out."""
+    """One run of two steps per distinct scene of the entries of the engines that compile
+    numba kernels (``HARNESS_DEFAULTS.numba``; the measuring code's kernels are compiled by
+    their runs too), with a long wall-clock limit: run one after the other before a suite,
+    they fill numba's cache, so that the suite's runs (each in a fresh worker, with the
+    entry's own limit) do not all compile the same kernels at once from an empty cache and
+    time out."""
     specs = {}
     for ident, entry in entries.items():
-        if engine_name(entry.get("engine")) not in NUMBA_ENGINES:
+        if not engine_defaults(engine_name(entry.get("engine")), extra_modules).numba:
             continue
         key = json.dumps([entry["scene"], entry.get("parameters")], sort_keys=True)
         if key in specs:

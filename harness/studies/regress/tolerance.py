@@ -11,8 +11,9 @@ one of three classes:
   may not grow; how much round-off or a contact model adds varies by machine, 9.66e-7 on one
   CPU and 8.99e-7 on another for the same code), quaternion norm errors and solver residuals
   (round-off of a normalisation or a stopping test), and the constraint violations of the rigid
-  engines (:data:`RIGID_ENGINES`: penetration, clearance excess, joint and driver errors,
-  creep of a body that must stick: round-off or solver tolerance). A new value passes when
+  engines (those declaring ``rigid_contacts``, :mod:`clearbench.adapters.harness_defaults`:
+  penetration, clearance excess, joint and driver errors, creep of a body that must stick:
+  round-off or solver tolerance). A new value passes when
   its magnitude stays below :data:`BOUND_HEADROOM` times the largest magnitude measured, or
   below the floor.
 - **statistical**: a figure the perturbations moved by more (impacts amplify round-off; the
@@ -70,21 +71,19 @@ ENSEMBLE_WIDEN = 1.0
 COUNT_FLOOR_RELATIVE = 0.05
 COUNT_FLOOR_ABSOLUTE = 0.5
 
-#: Engines without compliance: penetration and joint errors are round-off or the solver's
-#: stopping tolerance, not a property of the model.
-RIGID_ENGINES = ("reference", "siconos")
-
-#: (regular expression on the figure name, engines it applies to or None for every engine,
-#: why the figure is checked as a bound).
+#: (regular expression on the figure name, whether it applies to rigid engines only, why the
+#: figure is checked as a bound). In an engine without compliance (rigid contacts), penetration
+#: and joint errors are round-off or the solver's stopping tolerance, not a property of the
+#: model.
 BOUNDED_FIGURES = (
-    (r"energy_growth", None,
+    (r"energy_growth", False,
      "energy may not grow; its growth is round-off, a solver tolerance or a contact model's "
      "estimate, whose size only is a property of the code"),
-    (r"quaternion_norm_error", None, "round-off of the engine's quaternion normalisation"),
-    (r"solver_residual", None, "residual at convergence: round-off below the stopping test"),
+    (r"quaternion_norm_error", False, "round-off of the engine's quaternion normalisation"),
+    (r"solver_residual", False, "residual at convergence: round-off below the stopping test"),
     (r"penetration|clearance_excess|joint_distance|joint_angle|driver_offset|driver_angle",
-     RIGID_ENGINES, "a rigid engine's constraint violation: round-off or solver tolerance"),
-    (r"stiction|stick\.|latched\.", RIGID_ENGINES,
+     True, "a rigid engine's constraint violation: round-off or solver tolerance"),
+    (r"stiction|stick\.|latched\.", True,
      "a rigid engine's creep where physics says stick: round-off"),
 )
 
@@ -133,10 +132,11 @@ def figure_scale(name: str, scene: Scene, horizon: float, metrics: dict) -> floa
     return 1.0
 
 
-def bounded_reason(name: str, engine: str) -> str:
-    """Why figure ``name`` of ``engine`` is checked as a bound ('' when it is not)."""
-    for pattern, engines, why in BOUNDED_FIGURES:
-        if re.search(pattern, name) and (engines is None or engine in engines):
+def bounded_reason(name: str, rigid: bool) -> str:
+    """Why figure ``name`` of an engine with rigid contacts (``rigid``) or compliant ones is
+    checked as a bound ('' when it is not)."""
+    for pattern, rigid_only, why in BOUNDED_FIGURES:
+        if re.search(pattern, name) and (rigid or not rigid_only):
             return why
     return ""
 
@@ -232,12 +232,12 @@ def floor_of(name: str, base: float, scale: float) -> float:
     return FLOOR_RELATIVE * max(size, scale)
 
 
-def classify(name: str, engine: str, base: float, perturbed: list[float],
+def classify(name: str, rigid: bool, base: float, perturbed: list[float],
              scale: float) -> Check:
-    """The check of figure ``name`` of an ``engine`` run from its unperturbed value ``base``
-    and its values under the perturbations (``perturbed``; NaN where a run gave NaN, a run
-    that did not measure it left out), ``scale`` the scale of its dimension
-    (:func:`figure_scale`)."""
+    """The check of figure ``name`` of a run of an engine with rigid contacts (``rigid``) or
+    compliant ones from its unperturbed value ``base`` and its values under the perturbations
+    (``perturbed``; NaN where a run gave NaN, a run that did not measure it left out),
+    ``scale`` the scale of its dimension (:func:`figure_scale`)."""
     values = [base, *perturbed]
     finite = [v for v in values if math.isfinite(v)]
     nan_allowed = any(math.isnan(v) for v in values)
@@ -246,7 +246,7 @@ def classify(name: str, engine: str, base: float, perturbed: list[float],
     spread = max((abs(v - base) for v in perturbed if math.isfinite(v)), default=0.0) \
         if math.isfinite(base) else 0.0
     floor = floor_of(name, base, scale)
-    reason = bounded_reason(name, engine)
+    reason = bounded_reason(name, rigid)
     if reason and finite:
         largest = max(abs(v) for v in finite)
         limit = max(BOUND_HEADROOM * largest, floor)
