@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import time
 
 from clearbench.harness.cli.commands import command_help
@@ -55,6 +56,10 @@ def register(subparsers) -> None:
                         help="parallel workers (default: usable cores)")
     parser.add_argument("--runs-per-worker", type=int, default=1, metavar="N",
                         help="runs a worker serves before it is replaced (default 1)")
+    parser.add_argument("--timeout", type=float, default=None, metavar="SECONDS",
+                        help="wall-clock limit of every run (default: each entry's own, 300 s "
+                        "unless it says; numba cannot cache kernels compiled with NUMBA_OPT=0, "
+                        "so each worker then compiles them first: docs/harness.md#regression)")
     add_engine_option(parser, many=True,
                       help="only the suite's entries of these engines (ENGINE: all of its "
                       "entries, ENGINE[PRESET]: that label's); with --update, an engine with no "
@@ -86,6 +91,11 @@ def run_regress(args: argparse.Namespace) -> int:
         raise UserError(f"{args.baseline}: not a baseline file: {error}") from None
     if args.runs_per_worker < 1 or (args.jobs is not None and args.jobs < 1):
         raise UserError("--jobs and --runs-per-worker must be >= 1")
+    if args.timeout is not None:
+        if not args.timeout > 0:
+            raise UserError(f"--timeout {args.timeout:g}: expected a positive number of seconds")
+        specs = {ident: dataclasses.replace(spec, timeout=args.timeout)
+                 for ident, spec in specs.items()}
     if args.update:
         return _update(args, baseline, entries, specs, skipped, others, modules, start)
     for name in missing:
