@@ -26,7 +26,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from pydrake.common.eigen_geometry import Quaternion
 from pydrake.geometry import (
+    AddCompliantHydroelasticProperties,
     AddContactMaterial,
+    AddRigidHydroelasticProperties,
     Box,
     Capsule,
     CollisionFilterDeclaration,
@@ -58,7 +60,7 @@ from pydrake.systems.framework import DiagramBuilder
 from clearbench.adapters.drake.settings import DrakeSettings
 from clearbench.adapters.drake.topology import Topology, plan_topology
 from clearbench.adapters.force_elements import ForceElements, scene_force_elements
-from clearbench.adapters.primitive_pieces import side_geometry
+from clearbench.adapters.primitive_pieces import Piece, side_geometry
 from clearbench.kernels.quaternion import quat_normalize, quat_to_matrix
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.scales import largest_length
@@ -154,11 +156,38 @@ def pair_materials(scene: Scene, settings: DrakeSettings, dt: float) -> list[Pai
     return out
 
 
-def side_material(material: PairMaterial) -> ProximityProperties:
+def hydroelastic_pair(geometries, material: PairMaterial, settings: DrakeSettings) -> bool:
+    """True when a pair is built hydroelastic: ``hydroelastic_boxes`` on, a stiffness to derive
+    the modulus from, and both sides boxes or planes (at least one box)."""
+    kinds = {piece.kind for geometry in geometries for piece in geometry.pieces}
+    return (settings.hydroelastic_boxes and material.stiffness is not None
+            and kinds <= {"box", "plane"} and "box" in kinds)
+
+
+def hydroelastic_modulus(stiffness: float, half_extents) -> float:
+    """Modulus [F/L^2] giving a box pressed on a face about ``stiffness`` [F/L]: Drake's
+    compliant box has its pressure field over the smallest half extent h, so a face of area A
+    pressed by x carries about E A x / h."""
+    half = sorted(float(h) for h in half_extents)
+    return stiffness * half[0] / (4.0 * half[1] * half[2])
+
+
+def side_material(material: PairMaterial, piece=None, hydroelastic: bool = False,
+                  compliant_sides: int = 1) -> ProximityProperties:
     """Proximity properties of one side's geometry, so that Drake's combination of two equal
     sides gives the pair's values: stiffness 2k (series), SAP time constant tau / 2 (sum),
-    Hunt–Crossley d (stiffness-weighted mean), friction mu (2 mu^2 / 2 mu)."""
+    Hunt–Crossley d (stiffness-weighted mean), friction mu (2 mu^2 / 2 mu). A hydroelastic
+    pair's boxes are compliant (modulus :func:`hydroelastic_modulus` of the pair stiffness,
+    times ``compliant_sides``: Drake combines two compliant moduli in series), planes rigid."""
     properties = ProximityProperties()
+    if hydroelastic and piece is not None:
+        if piece.kind == "box":
+            AddCompliantHydroelasticProperties(
+                min(piece.size),
+                compliant_sides * hydroelastic_modulus(material.stiffness, piece.size),
+                properties)
+        else:
+            AddRigidHydroelasticProperties(properties)
     AddContactMaterial(
         dissipation=material.hunt_crossley,
         point_stiffness=None if material.stiffness is None else 2.0 * material.stiffness,
@@ -167,6 +196,18 @@ def side_material(material: PairMaterial) -> ProximityProperties:
     if material.relaxation_time is not None:
         properties.AddProperty("material", "relaxation_time", 0.5 * material.relaxation_time)
     return properties
+
+
+#: Half-spaces a plant holds safely: pydrake 1.51.1 segfaults registering the 15th HalfSpace
+#: on the world body (tests/test_drake_engine.py); beyond this count planes become boxes.
+MAX_HALF_SPACES = 8
+
+
+def plane_as_box(piece, half_size: float):
+    """A box of half size ``half_size`` [L] whose +z face is the plane ``piece``."""
+    rotation = quat_to_matrix(_unit(piece.orientation))
+    centre = np.asarray(piece.position, float) - half_size * rotation[:, 2]
+    return Piece("box", (half_size,) * 3, tuple(centre), piece.orientation)
 
 
 def _drake_shape(piece):
@@ -190,11 +231,12 @@ def _joint_frames(plant, bodies, scene, edge):
     frames = []
     for name in (edge.parent, edge.child):
         if name is None:
-            frames.append(plant.world_frame())
+            frames.append(plant.AddFrame(FixedOffsetFrame(f"{joint.name}@world",
+                                                          plant.world_frame(), x_wj)))
             continue
         x_bj = body_transform(scene, name).inverse() @ x_wj
         frames.append(plant.AddFrame(FixedOffsetFrame(f"{joint.name}@{name}",
-                                                         bodies[name].body_frame(), x_bj)))
+                                                      bodies[name].body_frame(), x_bj)))
     return frames
 
 
@@ -301,21 +343,33 @@ def build_plant(scene: Scene, settings: DrakeSettings, dt: float) -> BuiltPlant:
     geometry_pair: dict = {}
     sides_of_pair = []
     notes = {}
+    pair_geometries = [[side_geometry(scene, index, side, settings, length_scale)
+                        for side in ("a", "b")] for index in range(len(scene.all_contacts))]
+    planes = sum(piece.kind == "plane" for pair in pair_geometries for geometry in pair
+                 for piece in geometry.pieces)
     for index, contact in enumerate(scene.all_contacts):
         sides = []
-        for side in ("a", "b"):
-            geometry = side_geometry(scene, index, side, settings, length_scale)
-            notes[(contact.name, side)] = geometry.note
+        geometries = pair_geometries[index]
+        hydroelastic = hydroelastic_pair(geometries, materials[index], settings)
+        compliant_sides = sum(all(p.kind == "box" for p in g.pieces) for g in geometries)
+        for side, geometry in zip(("a", "b"), geometries, strict=True):
+            notes[(contact.name, side)] = geometry.note + (" (hydroelastic)" if hydroelastic
+                                                           else "")
             body_name = geometry.body
             fixed = body_name not in bodies
             frame_body = plant.world_body() if fixed else bodies[body_name]
             x_pre = body_transform(scene, body_name) if fixed else RigidTransform()
             ids = []
             for k, piece in enumerate(geometry.pieces):
-                x_bp = _transform(piece.position, piece.orientation)
+                # The material follows the scene's piece (a plane stays rigid as a box).
+                shape_piece = piece
+                if piece.kind == "plane" and planes > MAX_HALF_SPACES:
+                    shape_piece = plane_as_box(piece, settings.plane_box_size * length_scale)
+                x_bp = _transform(shape_piece.position, shape_piece.orientation)
                 ids.append(plant.RegisterCollisionGeometry(
-                    frame_body, x_pre @ x_bp, _drake_shape(piece),
-                    f"{contact.name}/{side}/{k}", side_material(materials[index])))
+                    frame_body, x_pre @ x_bp, _drake_shape(shape_piece),
+                    f"{contact.name}/{side}/{k}",
+                    side_material(materials[index], piece, hydroelastic, compliant_sides)))
             for gid in ids:
                 geometry_pair[gid] = (index, side)
             sides.append(ids)

@@ -12,7 +12,8 @@ the scene's units). Each step is ``Simulator.AdvanceTo`` of one period of the di
 - Read-out: ``EvalBodyPoseInWorld`` (the body frame), ``EvalBodySpatialVelocityInWorld`` (the
   body-frame origin's velocity, turned into the centre of mass's), and the contact results of
   the step just taken (sampled output port): per point pair, its geometries give the scene
-  pair; ``contact_force()`` acts on Drake's body B, normal ``nhat_BA_W`` from B to A.
+  pair; ``contact_force()`` acts on Drake's body B, normal ``nhat_BA_W`` from B to A; a
+  hydroelastic surface's ``F_Ac_W`` acts on geometry M's body, face normals from N into M.
 - Guards: a non-finite state, an exception from Drake's solver (recorded with its message) and,
   on scenes whose energy may only decrease, an energy gain above ``energy_gain_tolerance`` of
   the energy scale stop the run as DIVERGED.
@@ -204,6 +205,24 @@ class Runner:
             self.penetration_max = max(self.penetration_max, float(pair.depth))
             normal[index] += normal_force
             total[index] += force_on_drake_b if drake_b_side == "b" else -force_on_drake_b
+        for i in range(results.num_hydroelastic_contacts()):
+            info = results.hydroelastic_contact_info(i)
+            surface = info.contact_surface()
+            found = self.built.geometry_pair.get(surface.id_M())
+            if found is None:
+                continue
+            index, drake_m_side = found
+            # Face normals point out of N into M; the force acts on M's body at the centroid.
+            direction = sum(surface.area(f) * np.asarray(surface.face_normal(f))
+                            for f in range(surface.num_faces()))
+            direction = direction / max(np.linalg.norm(direction), 1e-300)
+            force_on_m = np.asarray(info.F_Ac_W().translational())
+            normal_force = float(force_on_m @ direction)
+            if normal_force <= 0.0:
+                continue
+            active += 1
+            normal[index] += normal_force
+            total[index] += force_on_m if drake_m_side == "b" else -force_on_m
         self.max_contacts = max(self.max_contacts, active)
         return normal, total, active
 
