@@ -257,6 +257,33 @@ def _add_tree_joint(plant, bodies, scene, edge, scene_parent_sign: float):
     return plant.AddJoint(WeldJoint(joint.name, parent_frame, child_frame, RigidTransform()))
 
 
+def _add_slides(plant, bodies, scene, name: str, held: bool) -> dict:
+    """Slides x, y, z from the world to the body's centre of mass (massless intermediate
+    bodies), then a ball joint (a weld when ``held``): joints by name ``BODY/slide_x`` ..."""
+    body = scene.body(name)
+    x_wb = body_transform(scene, name)
+    com = x_wb @ np.asarray(body.center_of_mass, float)
+    parent = plant.AddFrame(FixedOffsetFrame(f"{name}/slides@world", plant.world_frame(),
+                                             RigidTransform(com)))
+    joints = {}
+    for k, axis in enumerate("xyz"):
+        last = axis == "z" and held
+        child_body = bodies[name] if last else plant.AddRigidBody(
+            f"{name}/carriage_{axis}", SpatialInertia.Zero())
+        child = (plant.AddFrame(FixedOffsetFrame(f"{name}/slides@body", bodies[name].body_frame(),
+                                                 x_wb.inverse() @ RigidTransform(com)))
+                 if last else child_body.body_frame())
+        joint = plant.AddJoint(PrismaticJoint(f"{name}/slide_{axis}", parent, child,
+                                              np.eye(3)[k], -math.inf, math.inf, 0.0))
+        joints[joint.name()] = joint
+        parent = child
+    if not held:
+        child = plant.AddFrame(FixedOffsetFrame(f"{name}/ball@body", bodies[name].body_frame(),
+                                                x_wb.inverse() @ RigidTransform(com)))
+        plant.AddJoint(BallRpyJoint(f"{name}/ball", parent, child, 0.0))
+    return joints
+
+
 def _add_closure(plant, bodies, scene, joint, spacing: float) -> None:
     """A loop-closing joint as SAP constraints between its two bodies (world for fixed)."""
     anchor = np.asarray(joint.anchor, float)
@@ -327,15 +354,22 @@ def build_plant(scene: Scene, settings: DrakeSettings, dt: float) -> BuiltPlant:
         sign = 1.0 if edge.child == edge.joint.body_b else -1.0
         joints[edge.joint.name] = _add_tree_joint(plant, bodies, scene, edge, sign)
 
+    for body_name, held in topology.slides.items():
+        joints.update(_add_slides(plant, bodies, scene, body_name, held))
+
     driven = []
     for body_name, dofs in topology.driven.items():
         for dof in dofs:
-            edge = next(e for e in topology.edges if e.child == body_name)
-            joint = joints[edge.joint.name]
-            actuator = plant.AddJointActuator(f"{edge.joint.name}_driver", joint)
+            if dof.joint == "tree":
+                edge = next(e for e in topology.edges if e.child == body_name)
+                joint = joints[edge.joint.name]
+                inertia = _axis_inertia(scene, body_name, edge.joint)
+            else:
+                joint = joints[f"{body_name}/{dof.joint}"]
+                inertia = scene.body(body_name).mass
+            actuator = plant.AddJointActuator(f"{joint.name()}_driver", joint)
             actuator.set_default_gear_ratio(1.0)
-            actuator.set_default_rotor_inertia(
-                settings.driver_armature_ratio * _axis_inertia(scene, body_name, edge.joint))
+            actuator.set_default_rotor_inertia(settings.driver_armature_ratio * inertia)
             driven.append((joint, dof))
 
     materials = pair_materials(scene, settings, dt)
@@ -411,7 +445,7 @@ def _set_initial_state(scene, plant, context, bodies, topology, joints) -> None:
         if name not in bodies:
             continue
         plant.SetFreeBodyPose(context, bodies[name], body_transform(scene, name))
-        plant.SetFreeBodySpatialVelocity(bodies[name], _spatial_velocity(scene, name), context)
+        plant.SetFreeBodySpatialVelocity(context, bodies[name], _spatial_velocity(scene, name))
     for edge in topology.edges:
         joint = edge.joint
         if joint.kind not in ("revolute", "prismatic"):

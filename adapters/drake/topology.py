@@ -10,15 +10,24 @@ joint is a free body (Drake's quaternion floating joint). Loop closures are SAP 
 ``AddWeldConstraint``); TAMSI has no constraints and Drake has no prismatic one.
 
 Drivers: a driven component must be the coordinate of a revolute (prismatic) tree joint to a
-fixed body about (along) that world axis (:func:`~clearbench.adapters.joint_tree.plan_drivers`,
-the rule of every tree engine). Pure Python.
+fixed body about (along) that world axis, or a translation of a driven body with no ideal joint,
+which then hangs from the world by slides x, y, z (massless intermediate bodies) and a
+``BallRpyJoint`` at its centre of mass (none when its three rotations are held at zero)
+(:func:`~clearbench.adapters.joint_tree.plan_drivers`, the rule of every tree engine). Pure
+Python.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from clearbench.adapters.joint_tree import breadth_first_edges, plan_drivers, split_joint_graph
+from clearbench.adapters.joint_tree import (
+    breadth_first_edges,
+    plan_drivers,
+    rotations_held,
+    split_joint_graph,
+)
+from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.scene import Scene
 
 __all__ = ["Topology", "TreeEdge", "plan_topology"]
@@ -46,6 +55,7 @@ class Topology:
     closures: tuple
     driven: dict
     problems: tuple
+    slides: dict
 
 
 def plan_topology(scene: Scene, approximation: str) -> Topology:
@@ -56,15 +66,23 @@ def plan_topology(scene: Scene, approximation: str) -> Topology:
              for parent, joint, child in breadth_first_edges(graph.adjacency,
                                                              sorted(graph.fixed), visited)]
     free = []
+    slides = {}
     for body in scene.bodies:
         if body.name in visited:
             continue
         visited.add(body.name)
+        rotations = [d for d in graph.drivers_of.get(body.name, ()) if d.is_rotation]
+        if (body.motion is Motion.DRIVEN and not graph.adjacency[body.name]
+                and (not rotations or rotations_held(rotations))):
+            # Slides x, y, z from the world, then a ball joint at the centre of mass unless
+            # every rotation is held at zero.
+            slides[body.name] = bool(rotations)
+            continue
         free.append(body.name)
         edges += [TreeEdge(parent, child, joint) for parent, joint, child in
                   breadth_first_edges(graph.adjacency, [body.name], visited)]
     driven, problems = plan_drivers(
-        scene, graph.drivers_of, set(),
+        scene, graph.drivers_of, set(slides),
         {e.child: e.joint.name for e in edges
          if e.parent is None and e.joint.kind in ("revolute", "prismatic")}, "Drake")
     problems = list(problems)
@@ -77,4 +95,4 @@ def plan_topology(scene: Scene, approximation: str) -> Topology:
             problems.append((f"joint:{joint.kind}", f"joint {joint.name!r} closes a loop and "
                              f"Drake has no {joint.kind} constraint"))
     return Topology(graph.fixed, tuple(edges), tuple(free), graph.closures, driven,
-                    tuple(problems))
+                    tuple(problems), slides)
