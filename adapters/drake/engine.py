@@ -8,8 +8,9 @@ Presets (each a separate engine variant ``drake[<preset>]``; see :mod:`.settings
   approximation, ``hydroelastic_with_fallback`` (point contact for these primitives), stiffness
   and Hunt–Crossley dissipation estimated from ``penetration_allowance`` 1 mm, stiction
   tolerance 1e-4 m/s; only the scene's friction set on the geometries;
-- ``tuned``: SAP, point contact, stiffness of a 2-step contact half period, dissipation time
-  constant of one step, stiction tolerance 1e-6 m/s (docs/engines/drake.md).
+- ``tuned``: SAP, point contact with hydroelastic boxes, stiffness of a 2-step contact half
+  period, dissipation time constant of 4 steps (e = 0; e > 0 mapped), stiction tolerance
+  1e-6 m/s (docs/engines/drake.md).
 
 ``RunSettings.options`` override any field of :class:`~.settings.DrakeSettings`, checked
 before anything runs; what each scene feature becomes: :mod:`.capabilities`.
