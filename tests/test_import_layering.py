@@ -25,7 +25,7 @@ SCENE_CONTENT = ("clearbench.scenarios.library", "clearbench.scenarios.analytic"
                  "clearbench.scenarios.c60")
 #: Shared modules of the adapters package; every other child of it is one engine's subpackage.
 ADAPTER_SHARED = frozenset({"base", "trajectory", "recording", "joint_tree", "force_elements",
-                            "energy_guard", "options"})
+                            "energy_guard", "options", "primitive_pieces"})
 
 
 def _module_files() -> dict[str, Path]:
