@@ -33,6 +33,7 @@ ENGINES: dict[str, str] = {
     "siconos": "clearbench.adapters.siconos",
     "pybullet": "clearbench.adapters.pybullet",
     "exudyn": "clearbench.adapters.exudyn",
+    "drake": "clearbench.adapters.drake",
 }
 
 

@@ -25,7 +25,8 @@ SCENE_CONTENT = ("clearbench.scenarios.library", "clearbench.scenarios.analytic"
                  "clearbench.scenarios.c60")
 #: Shared modules of the adapters package; every other child of it is one engine's subpackage.
 ADAPTER_SHARED = frozenset({"base", "trajectory", "recording", "joint_tree", "force_elements",
-                            "energy_guard", "options", "harness_defaults"})
+                            "energy_guard", "options", "harness_defaults",
+                            "primitive_pieces"})
 
 
 def _module_files() -> dict[str, Path]:
