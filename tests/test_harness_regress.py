@@ -115,3 +115,19 @@ def test_regress_covers_one_quick_scene_per_available_engine():
     assert " -> 1 (" in lines[0]
     assert lines[0].endswith(f"[engine version changed: older -> "
                              f"{results[ident]['engine_version']}]")
+
+
+def test_an_update_of_one_engine_keeps_the_versions_of_the_engines_it_did_not_measure():
+    """`regress --update -e NAME` keeps the other engines' results: their versions stay in
+    ``recorded.engines`` beside the measured engine's (they were dropped once)."""
+    suite = [{"id": "a", "scene": "pendulum", "engine": "mujoco[tuned]"},
+             {"id": "b", "scene": "pendulum", "engine": "reference"}]
+    baseline = {"suite": suite, "perturbations": ROUNDOFF_ONLY,
+                "results": {"a": {"status": "ok"}, "b": {"status": "ok"}},
+                "recorded": {"engines": {"mujoco": "mujoco 1.0", "reference": "built in"}}}
+    fresh = {"b": {"status": "ok", "engine": "reference[default]", "engine_version": "new",
+                   "scene_hash": "h", "expectations_passed": True, "metrics": {},
+                   "checks": {}}}
+    written = updated_baseline(baseline, fresh, {"a": "not chosen"})
+    assert written["recorded"]["engines"] == {"mujoco": "mujoco 1.0", "reference": "new"}
+    assert written["results"]["a"] == {"status": "ok"}

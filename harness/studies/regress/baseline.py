@@ -106,7 +106,7 @@ def updated_baseline(baseline: dict, results: dict[str, dict],
                      extra_modules: Mapping[str, str] | None = None) -> dict:
     """The baseline with ``results`` (each with its ``checks``), ``tolerance_model`` and
     ``recorded`` replaced (the results of ``skipped`` runs, whose engine is not available
-    here or was not chosen, kept as they were); ``cost``: runs, worker seconds and seconds of
+    here or was not chosen, kept as they were, with their engines' versions); ``cost``: runs, worker seconds and seconds of
     the measurement."""
     new = {key: value for key, value in baseline.items() if key != "tolerances"}
     new.setdefault("perturbations", default_perturbations(extra_modules=extra_modules))
@@ -119,11 +119,27 @@ def updated_baseline(baseline: dict, results: dict[str, dict],
     new["recorded"] = {"revision": revision["revision"], "dirty": revision["dirty"],
                        "machine": f"{machine['hostname']} ({machine['cpu']})",
                        "date": datetime.now(UTC).isoformat(timespec="seconds"),
-                       "engines": {r["engine"].split("[", 1)[0]: r.get("engine_version", "")
-                                   for r in results.values() if r.get("engine")}}
+                       "engines": _engine_versions(baseline, kept, results)}
     if cost:
         new["recorded"]["cost"] = {k: round(float(v), 1) for k, v in cost.items()}
     return new
+
+
+def _engine_versions(baseline: dict, kept: Mapping[str, dict],
+                     results: Mapping[str, dict]) -> dict[str, str]:
+    """Engine name -> version of the engines measured (``results``) and of those whose results
+    were ``kept`` (their versions as the baseline recorded them)."""
+    recorded = baseline.get("recorded", {}).get("engines", {})
+    labels = {entry.get("id"): entry.get("engine") or "reference"
+              for entry in baseline.get("suite", [])}
+    versions = {}
+    for ident in kept:
+        name = str(labels.get(ident, "")).split("[", 1)[0]
+        if name in recorded:
+            versions[name] = recorded[name]
+    versions.update({r["engine"].split("[", 1)[0]: r.get("engine_version", "")
+                     for r in results.values() if r.get("engine")})
+    return versions
 
 
 def write_baseline(path: str | Path, baseline: dict) -> None:
