@@ -106,8 +106,8 @@ def updated_baseline(baseline: dict, results: dict[str, dict],
                      extra_modules: Mapping[str, str] | None = None) -> dict:
     """The baseline with ``results`` (each with its ``checks``), ``tolerance_model`` and
     ``recorded`` replaced (the results of ``skipped`` runs, whose engine is not available
-    here or was not chosen, kept as they were, with their engines' versions); ``cost``: runs, worker seconds and seconds of
-    the measurement."""
+    here or was not chosen, kept as they were, with their engines' versions); ``cost``: runs,
+    worker seconds and seconds of the measurement."""
     new = {key: value for key, value in baseline.items() if key != "tolerances"}
     new.setdefault("perturbations", default_perturbations(extra_modules=extra_modules))
     new["tolerance_model"] = tolerance_model(extra_modules)
