@@ -176,10 +176,20 @@ def test_the_sliding_box_stops_at_the_analytic_time_in_every_engine(tmp_path):
         stop = {r["name"]: r for r in json.loads(row["expectations"])}["stop"]
         print(f"{label}: stop_time {stop['figures']['stop_time']:.4g} s (analytic "
               f"{expected:.4g} s); {stop['detail']}")
-        late[label] = abs(stop["figures"]["stop_time"] - expected) / expected
-    # Every engine is seen to stop within 5 % of v0 / (mu g): a soft or regularised friction
-    # slows the last millimetres (measured: mujoco[default] 2.4 % late); a threshold the
-    # engines cannot meet read as a stop twice as late, or never (NaN fails too).
+        figures = stop["figures"]
+        if abs(figures["stop_distance_error"]) > 0.2 * figures["expected_stop_distance"]:
+            # Stopped more than 20 % (10 times the scene's 2 % tolerance) from v0^2 / (2 mu g):
+            # the engine's friction does not decelerate the box at mu g (measured: Drake's
+            # default point contact holds the box on one corner and stops it 95 % short), so
+            # v0 / (mu g) is not its stop time; its stop check must fail on the distance.
+            assert stop["passed"] is False, (label, stop)
+            continue
+        late[label] = abs(figures["stop_time"] - expected) / expected
+    # Every engine that slides as Coulomb's law says is seen to stop within 5 % of
+    # v0 / (mu g): a soft or regularised friction slows the last millimetres (measured:
+    # mujoco[default] 2.4 % late); a threshold the engines cannot meet read as a stop twice as
+    # late, or never (NaN fails too).
+    assert "reference" in late
     assert all(value < 0.05 for value in late.values()), late
 
 
