@@ -30,6 +30,7 @@ or bad option value).
 from __future__ import annotations
 
 import enum
+import importlib
 import time
 from abc import ABC, abstractmethod
 from collections.abc import Mapping, Sequence
@@ -223,8 +224,17 @@ class Engine(ABC):
             return Trajectory.empty(self.name, self.preset, scene, RunStatus.UNSUPPORTED,
                                     "; ".join(reasons))
         trajectory = self._run(scene, settings)
-        trajectory.metadata.setdefault("rigid_contacts", self.RIGID_CONTACTS)
+        trajectory.rigid_contacts = bool(self.RIGID_CONTACTS)
+        trajectory.engine_version = self.version()
         return trajectory
+
+    def version(self) -> str:
+        """The engine and its version as the ``availability()`` of its adapter's package
+        states them ('' when the package has no probe)."""
+        package = importlib.import_module(type(self).__module__.rpartition(".")[0]
+                                          or type(self).__module__)
+        probe = getattr(package, "availability", None)
+        return str(probe()[1]) if probe is not None else ""
 
     @abstractmethod
     def _run(self, scene: Scene, settings: RunSettings) -> Trajectory:
@@ -254,6 +264,14 @@ class ModuleEngine(Engine):
 
     def check_option_combination(self, options: Mapping) -> None:
         self.settings(options)
+
+    def run_settings(self, scene: Scene, settings: RunSettings) -> Any:
+        """The settings of one run of ``scene``, resolved once: the preset overridden by
+        ``settings.options`` (checked against :attr:`OPTIONS`; OptionError naming the option
+        and value). An engine whose settings depend on the scene (tolerances relative to its
+        sizes) overrides it."""
+        self.check_options(settings.options)
+        return self.settings(settings.options)
 
     def capability_scene(self, scene: Scene, settings) -> Scene:
         """The scene the capabilities are stated for (default: as given; an engine that
@@ -296,16 +314,16 @@ class SteppingEngine(ModuleEngine):
     supplies the hooks :meth:`build`, :meth:`runner` and :meth:`metadata` (and, where it needs
     them, :meth:`internal_scene`, :meth:`step`, :meth:`release`, :meth:`steps_taken`).
 
-    The runner a hook returns has ``run() -> (RunStatus, message)``, a ``recorder``
-    (:class:`~clearbench.adapters.recording.SampleRecorder`), ``stepping_seconds`` and
-    ``steps_taken``.
+    The runner a hook returns has ``run() -> (RunStatus, message)`` and a ``monitor``
+    (:class:`~clearbench.adapters.step_monitor.StepMonitor`: recorder, guards, unconverged
+    steps, stepping time, steps taken), whose statistics fill the trajectory's typed fields.
     """
 
     #: The engine's name in prose (``"MuJoCo"``), for notes of the run.
     TITLE: ClassVar[str] = ""
 
     def _run(self, scene: Scene, settings: RunSettings) -> Trajectory:
-        config = self.settings(settings.options)
+        config = self.run_settings(scene, settings)
         start = time.perf_counter()
         internal = self.internal_scene(scene, config)
         to_internal = scene.units.factor_to(internal.units, TIME)
@@ -323,10 +341,12 @@ class SteppingEngine(ModuleEngine):
             status, message = self.step(runner)
         finally:
             self.release(built)
-        return runner.recorder.trajectory(
+        monitor = runner.monitor
+        return monitor.recorder.trajectory(
             scene, dt, recorded_units=internal.units, engine=self.name, preset=self.preset,
-            build_seconds=build_seconds, stepping_seconds=runner.stepping_seconds,
+            build_seconds=build_seconds, stepping_seconds=monitor.stepping_seconds,
             steps=self.steps_taken(runner, steps, dt), status=status, message=message,
+            internal_units=internal.units.describe(), **monitor.statistics(),
             metadata=self.metadata(scene, internal, config, built, runner))
 
     # ------------------------------------------------------------------ hooks
@@ -358,12 +378,5 @@ class SteppingEngine(ModuleEngine):
         """Free what the model holds outside Python (default: nothing)."""
 
     def steps_taken(self, runner, steps: int, dt: float) -> int:
-        """Steps the run took of its ``steps`` of ``dt`` (default: as the runner counted)."""
-        return runner.steps_taken
-
-    def units_note(self, scene: Scene, internal: Scene) -> str:
-        """The metadata's ``units``: the units the engine ran in."""
-        if internal.units != scene.units:
-            return (f"scene in {scene.units.describe()} rescaled to "
-                    f"{internal.units.describe()} for {self.TITLE}; results converted back")
-        return f"run in the scene's units ({scene.units.describe()})"
+        """Steps the run took of its ``steps`` of ``dt`` (default: as the monitor counted)."""
+        return runner.monitor.steps_taken

@@ -14,6 +14,11 @@ scenes in its ``default`` preset, compliant, no C-60 ladder, a colour from the p
 
 Times are in the time unit of the scene they apply to (s for the library's quick scenes, ms
 for the C-60, whose units are mm-g-ms).
+
+The C-60 step costs the engines declare (``c60_step_cost``) were measured by one ``clearbench
+demo`` on a 2-core machine (each engine's demo-plan c60-on runs, 4 ms of horizon, wall time per
+step over the reference's 1.35 ms per step at 1 us): MuJoCo tuned 0.32, PyBullet tuned 4.3,
+Drake tuned 9.6, Siconos 53 (at 10 us), Exudyn mechanism 98.
 """
 
 from __future__ import annotations
@@ -155,6 +160,11 @@ class HarnessDefaults:
         Plan -> C-60 scene -> preset -> steps [ms] of ``clearbench c60 compare`` (an engine
         that cannot build the C-60 may still declare a step: its run is recorded
         ``unsupported`` with the reason).
+    c60_step_cost : float
+        Its wall time per C-60 step relative to the reference engine's (both at their plan
+        steps, measured side by side in one ``clearbench c60 compare``: wall [s] / steps). The
+        plans start the runs of largest expected cost (steps x this) first, so that a plan's
+        wall time is about its longest run's rather than that run's plus all before it.
     colour : str, optional
         ``#RRGGBB`` of its lines in every figure of the report (default: one of the
         palette's, the same for the same name).
@@ -166,9 +176,13 @@ class HarnessDefaults:
     numba: bool = False
     perturbations: tuple[OptionPerturbation, ...] = ()
     c60_ladders: C60Ladders = field(default_factory=dict)
+    c60_step_cost: float = 1.0
     colour: str | None = None
 
     def __post_init__(self) -> None:
+        if not self.c60_step_cost > 0:
+            raise ValueError(f"HarnessDefaults.c60_step_cost = {self.c60_step_cost!r}: "
+                             "must be > 0")
         if self.colour is not None and not _COLOUR.match(self.colour):
             raise ValueError(f"HarnessDefaults.colour = {self.colour!r}: expected #RRGGBB")
         for plan, scenes in self.c60_ladders.items():

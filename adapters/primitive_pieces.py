@@ -25,9 +25,8 @@ bore       capsules along the bore axis lining the hole (``bore_pieces`` per ful
            radius rho = bore_piece_radius R, axes on the circle of radius R - d + rho
 =========  ==========================================================================
 
-``settings`` is any object with the fields ``ring_pieces``, ``ring_piece_radius``,
-``bore_pieces``, ``bore_piece_radius``, ``face_thickness`` and ``plane_box_size`` (the
-engines' settings dataclasses). Pure Python.
+``settings`` is a :class:`PieceSettings` (the settings dataclass of each engine that builds
+with pieces derives from it, and its option table includes :data:`PIECE_OPTIONS`). Pure Python.
 """
 
 from __future__ import annotations
@@ -37,6 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from clearbench.adapters.options import integer, number
 from clearbench.kernels.quaternion import (
     quat_from_matrix,
     quat_multiply,
@@ -59,9 +59,53 @@ from clearbench.scenarios.shapes import (
     Sphere,
 )
 
-__all__ = ["Piece", "SideGeometry", "face_thickness", "journal_clearance_growth", "journal_of",
-           "pair_clearance_growth", "ring_chord_error", "ring_sphere_radius", "ring_step",
+__all__ = ["PIECE_OPTIONS", "Piece", "PieceSettings", "SideGeometry", "face_thickness",
+           "journal_clearance_growth", "journal_of", "pair_clearance_growth", "ring_chord_error",
+           "ring_sphere_radius", "ring_step",
            "side_geometry", "toward_partner"]
+
+@dataclass(frozen=True)
+class PieceSettings:
+    """How rings, bores and bounded faces are built from primitives (the fields of every
+    engine settings dataclass that derives from it).
+
+    Attributes
+    ----------
+    ring_pieces : int
+        Spheres per full circle of a ring (circle or arc shape).
+    ring_piece_radius : float
+        Least radius of a ring sphere relative to the ring radius (a pair's positive offset
+        gives larger spheres); capped at half the radial clearance of a clearance joint.
+    bore_pieces : int
+        Capsules per full circle lining a bore.
+    bore_piece_radius : float
+        Radius of the bore capsules relative to the bore radius.
+    face_thickness : float
+        Thickness of the box (rectangle) or cylinder (disc) standing in for a bounded face
+        without ``depth``, relative to its larger half extent (or radius).
+    plane_box_size : float
+        Half size of the box standing in for a plane on a moving body, relative to the scene's
+        largest length.
+    """
+
+    ring_pieces: int = 64
+    ring_piece_radius: float = 0.01
+    bore_pieces: int = 64
+    bore_piece_radius: float = 0.05
+    face_thickness: float = 0.1
+    plane_box_size: float = 100.0
+
+
+#: Type and range of each field of :class:`PieceSettings`, for the engines' option tables.
+PIECE_OPTIONS = (
+    integer("ring_pieces", at_least=3),
+    number("ring_piece_radius", above=0.0),
+    integer("bore_pieces", at_least=3),
+    number("bore_piece_radius", above=0.0),
+    number("face_thickness", above=0.0),
+    number("plane_box_size", above=0.0),
+)
+
 
 @dataclass(frozen=True)
 class Piece:

@@ -59,6 +59,23 @@ class Trajectory:
         Wall time of building the model and of stepping alone [s].
     steps : int
         Number of steps taken (may exceed T - 1 when recording is subsampled).
+    engine_version : str
+        The engine and its version as its availability probe states them (``mujoco 3.3.0``).
+    rigid_contacts : bool
+        The engine's contacts have no compliance (impulses): its penetration and stick creep
+        are round-off or a solver tolerance (``HarnessDefaults.rigid_contacts``).
+    unconverged_steps : tuple of int
+        Steps (1-based, over every step taken, not only the recorded ones) whose one-step
+        problem did not converge: the first 1,000; ``unconverged_count`` counts them all.
+    energy_max_gain : float
+        Largest mechanical-energy gain over the energy scale the run's energy guard saw
+        (dimensionless; NaN where the guard was off or the engine has none).
+    solver_seconds : float
+        Wall time inside the contact solver [s] (NaN where the engine does not say).
+    internal_units : str
+        The units the engine ran in, and whether the results were converted back.
+    metadata : dict
+        The engine's own notes of the run (settings, guards, statistics only it has).
     """
 
     engine: str
@@ -85,7 +102,18 @@ class Trajectory:
     steps: int = 0
     status: RunStatus = RunStatus.OK
     message: str = ""
+    engine_version: str = ""
+    rigid_contacts: bool = False
+    unconverged_steps: tuple = ()
+    unconverged_count: int = 0
+    energy_max_gain: float = float("nan")
+    solver_seconds: float = float("nan")
+    internal_units: str = ""
     metadata: dict = field(default_factory=dict)
+
+    #: The run statistics every engine fills (the harness reads them by attribute).
+    STATISTICS = ("engine_version", "rigid_contacts", "unconverged_steps", "unconverged_count",
+                  "energy_max_gain", "solver_seconds", "internal_units")
 
     ARRAYS = ("times", "positions", "orientations", "velocities", "angular_velocities",
               "contact_normal_force", "contact_force", "solver_iterations", "solver_residual",
@@ -97,11 +125,6 @@ class Trajectory:
     def contact_index(self, name: str) -> int:
         return self.contact_names.index(name)
 
-    @property
-    def unconverged_steps(self) -> np.ndarray:
-        """Indices of recorded steps whose one-step problem did not converge."""
-        return np.nonzero(~self.solver_converged.astype(bool))[0]
-
     def save(self, path: str | Path) -> None:
         """Write to a .npz file (arrays float64/int64/bool, header as JSON)."""
         header = {
@@ -110,8 +133,10 @@ class Trajectory:
             "body_names": list(self.body_names), "contact_names": list(self.contact_names),
             "build_seconds": self.build_seconds, "stepping_seconds": self.stepping_seconds,
             "steps": self.steps, "status": self.status.value, "message": self.message,
+            **{name: getattr(self, name) for name in self.STATISTICS},
             "metadata": self.metadata,
         }
+        header["unconverged_steps"] = [int(k) for k in self.unconverged_steps]
         arrays = {name: getattr(self, name) for name in self.ARRAYS}
         np.savez_compressed(path, header=np.array(json.dumps(header)), **arrays)
 
@@ -123,6 +148,11 @@ class Trajectory:
         header["body_names"] = tuple(header["body_names"])
         header["contact_names"] = tuple(header["contact_names"])
         header["status"] = RunStatus(header["status"])
+        for name in cls.STATISTICS:  # files written before these fields kept some in metadata
+            if name not in header and name in header["metadata"]:
+                header[name] = header["metadata"].pop(name)
+        header["unconverged_steps"] = tuple(header.get("unconverged_steps", ()))
+        header.setdefault("unconverged_count", len(header["unconverged_steps"]))
         return cls(**header, **arrays)
 
     @classmethod

@@ -97,12 +97,19 @@ def _checkout_cache_root() -> Path:
         / "clearbench-numba-checkouts" / checkout[:12]
 
 
+def checkout_cache_dir() -> Path:
+    """The cache directory of this checkout and the state of its physics sources (those of
+    :data:`_KERNEL_SUBPACKAGES`): numba's kernels and what is derived from those sources
+    alone (the features of the registered scenes) live there; older states' are pruned."""
+    return _checkout_cache_root() / _sources_fingerprint()
+
+
 def numba_cache_dir(environ=None) -> Path:
     """numba's cache directory for this checkout, the state of its sources and the numba
     code-generation settings of ``environ`` (default ``os.environ``;
     :data:`NUMBA_CODEGEN_VARIABLES`): a sub-directory per combination of those that are set."""
     environ = os.environ if environ is None else environ
-    current = _checkout_cache_root() / _sources_fingerprint()
+    current = checkout_cache_dir()
     codegen = [f"{name}={environ[name]}" for name in NUMBA_CODEGEN_VARIABLES
                if environ.get(name)]
     if codegen:

@@ -4,11 +4,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from clearbench.kernels.time_profiles import (
-    evaluate_profile,
-    evaluate_profile_integral,
-    evaluate_profile_slope,
-)
 from clearbench.scenarios.element import Element
 from clearbench.scenarios.time_profiles import check_profile
 from clearbench.scenarios.validation import (
@@ -21,6 +16,15 @@ from clearbench.scenarios.validation import (
     check_name,
     dim,
 )
+
+
+def _profiles():
+    """:mod:`clearbench.kernels.time_profiles`, imported at the first evaluation: it imports
+    numba (about a second), which building, validating and listing scenes do not need."""
+    from clearbench.kernels import time_profiles
+
+    return time_profiles
+
 
 #: Components a driver can prescribe: translation of the centre of mass along a world axis, or
 #: rotation about a world axis through the centre of mass.
@@ -77,12 +81,12 @@ class Driver(Element):
         """Prescribed rate of the component at time(s) ``t`` [L/T or rad/T]: the profile of a
         velocity driver, the slope of the current segment of a position driver."""
         if self.quantity == "velocity":
-            return evaluate_profile(self.times, self.values, t)
-        return evaluate_profile_slope(self.times, self.values, t)
+            return _profiles().evaluate_profile(self.times, self.values, t)
+        return _profiles().evaluate_profile_slope(self.times, self.values, t)
 
     def displacement(self, t):
         """Prescribed displacement of the component from t = 0 [L or rad]: the profile of a
         position driver, the integral from 0 of a velocity driver's."""
         if self.quantity == "position":
-            return evaluate_profile(self.times, self.values, t)
-        return evaluate_profile_integral(self.times, self.values, t)
+            return _profiles().evaluate_profile(self.times, self.values, t)
+        return _profiles().evaluate_profile_integral(self.times, self.values, t)

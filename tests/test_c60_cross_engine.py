@@ -17,7 +17,12 @@ from clearbench.harness.report.c60_section import (
 )
 from clearbench.harness.report.engine_style import engine_style
 from clearbench.harness.run.engine_choice import EngineChoice
-from clearbench.harness.studies.c60_comparison import c60_plan, plan_engines, plan_runs
+from clearbench.harness.studies.c60_comparison import (
+    c60_plan,
+    expected_cost,
+    plan_engines,
+    plan_runs,
+)
 from clearbench.scenarios.library import get_scene
 
 FC_REST = {"FC-2": 10.62, "FC-3": 2.83, "FC-4": 10.73, "FC-5": 2.29, "FC-6": 0.51}
@@ -123,13 +128,21 @@ def test_joint_excess_groups_the_ring_pairs_by_joint():
     assert excess["J6"] == 3e-3 and excess["J1"] == 0.0
 
 
-def test_demo_plan_runs_reference_first_with_shortened_horizons():
+def test_demo_plan_runs_longest_first_with_shortened_horizons():
     engines = [EngineChoice("mujoco", "tuned", "clearbench.adapters.mujoco", ""),
-               EngineChoice("reference", "default", "clearbench.adapters.reference", "")]
+               EngineChoice("reference", "default", "clearbench.adapters.reference", ""),
+               EngineChoice("exudyn", "mechanism", "clearbench.adapters.exudyn", "")]
     demo = c60_plan("demo")
     specs = plan_runs(demo, engines)
-    assert specs[0].engine.label == "reference[default]"
-    assert {s.engine.label for s in specs} == {"reference[default]", "mujoco[tuned]"}
+    # Exudyn's 4,000 C-60 steps at 98 reference steps each come first, then the reference's
+    # 8,500-step c60-trip; MuJoCo's 8 us c60-on (500 steps at 0.32) is last.
+    assert [s.engine.label for s in specs[:2]] == ["exudyn[mechanism]", "reference[default]"]
+    assert specs[1].scene.name == "c60-trip"
+    assert (specs[-1].engine.label, specs[-1].time_step) == ("mujoco[tuned]", 8e-3)
+    costs = [expected_cost(s) for s in specs]
+    assert costs == sorted(costs, reverse=True)
+    assert {s.engine.label for s in specs} == {"reference[default]", "mujoco[tuned]",
+                                              "exudyn[mechanism]"}
     for spec in specs:
         assert spec.horizon == demo.horizons[spec.scene.name]
         # about one sample per 0.01 ms, whatever the step

@@ -22,7 +22,7 @@ PENETRATION_LIMIT = 1e-6
 
 
 def unconverged(trajectory) -> list:
-    return list(trajectory.metadata["unconverged_steps"])
+    return list(trajectory.unconverged_steps)
 
 
 def test_short_on_run_takes_up_the_clearances_without_penetration():

@@ -8,7 +8,9 @@ from pathlib import Path
 import pytest
 
 from clearbench.harness.cli.main import main
-from clearbench.scenarios.library import scene_names
+from clearbench.harness.cli.scenes import scene_features
+from clearbench.scenarios.library import get_entry, scene_names
+from clearbench.scenarios.registry import SceneEntry
 from clearbench.scenarios.serialization import load_scene_file, scene_from_toml
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -135,3 +137,17 @@ def test_the_magnitude_bound_lets_every_library_scene_through():
 
     for name in scene_names():
         get_entry(name).build().rescaled(UnitSystem("um", "mg", "us"))
+
+
+def test_list_features_come_from_the_cache_and_are_the_built_scenes_features(
+        tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    names = ["pendulum", "clearance-pendulum"]
+    first = scene_features(names)
+    assert first == {name: sorted(get_entry(name).build().features) for name in names}
+
+    def no_build(self, **parameters):
+        raise AssertionError(f"{self.name} built although its features are cached")
+
+    monkeypatch.setattr(SceneEntry, "build", no_build)
+    assert scene_features(names) == first

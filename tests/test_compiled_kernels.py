@@ -142,7 +142,7 @@ def test_cluster_inverse_inverts_each_block_and_zeroes_fixed_bodies():
 @pytest.mark.parametrize("scene_name", ["clearance-pendulum", "slider-crank"])
 def test_compiled_projection_follows_the_numpy_projection(scene_name):
     scene = get_scene(scene_name)
-    settings = create().stepper_settings(scene, RunSettings())
+    settings = create().run_settings(scene, RunSettings())
     runs = {}
     for compiled in (True, False):
         stepper = MoreauJeanStepper(build_system(scene), settings)

@@ -22,7 +22,7 @@ from clearbench.adapters.base import RunSettings
 from clearbench.adapters.options import OptionError
 from clearbench.adapters.reference.build import build
 from clearbench.adapters.reference.engine import create
-from clearbench.adapters.reference.step_loop import choose_step_loop
+from clearbench.adapters.reference.run import choose_step_loop
 from clearbench.scenarios.library import get_scene, scene_names
 from clearbench.scenarios.scales import scene_size
 
@@ -44,7 +44,7 @@ def _velocity_scale(scene, length: float) -> float:
 def _supported(scene) -> bool:
     engine = create("default")
     settings = RunSettings()
-    model = build(scene, engine.stepper_settings(scene, settings))
+    model = build(scene, engine.run_settings(scene, settings))
     return choose_step_loop("auto", model.stepper).compiled
 
 
@@ -72,7 +72,7 @@ def _compare(name: str) -> None:
     assert np.max(np.abs(compiled.contact_force - python.contact_force), initial=0.0) \
         <= AGREEMENT * force
     np.testing.assert_array_equal(compiled.active_contacts, python.active_contacts)
-    assert compiled.metadata["unconverged_steps"] == python.metadata["unconverged_steps"]
+    assert compiled.unconverged_steps == python.unconverged_steps
 
 
 @pytest.mark.parametrize("name", scene_names())

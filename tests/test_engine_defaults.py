@@ -116,6 +116,8 @@ def test_a_label_without_a_ladder_in_the_plan_is_left_out_with_the_reason():
 def test_bad_declarations_are_refused_naming_the_field():
     with pytest.raises(ValueError, match="colour = 'red'"):
         HarnessDefaults(colour="red")
+    with pytest.raises(ValueError, match="c60_step_cost = 0"):
+        HarnessDefaults(c60_step_cost=0)
     with pytest.raises(ValueError, match=r"c60_ladders\['demo'\]\['c60-on'\]\['default'\]"):
         HarnessDefaults(c60_ladders={"demo": {"c60-on": {"default": (0.0,)}}})
     with pytest.raises(ValueError, match="horizon = -1"):

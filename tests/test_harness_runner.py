@@ -240,3 +240,20 @@ def test_measure_phase_errors_do_not_hide_the_run(tmp_path):
     assert row["status"] == "ok"
     assert math.isfinite(row["stepping_seconds_per_step"]) and row["stepping_seconds_per_step"] > 0
     assert os.path.exists(store.directory / row["trajectory"])
+
+
+def test_a_run_measured_against_a_reference_of_its_batch_starts_after_it(tmp_path):
+    # One batch holds a slow fine reference and two runs measured against it, on two
+    # workers: neither run may start before the reference is stored (its error would be
+    # measured against nothing), and both get their error.
+    from clearbench.harness.run.runner import RunJob
+
+    store = ResultsStore(tmp_path / "store")
+    fine = fake_spec(time_step=5e-4, options={"sleep": 2.0})
+    runs = [RunJob(fake_spec(time_step=dt), reference_key=fine.key) for dt in (1e-3, 2e-3)]
+    Runner(store, jobs=2).run_all([RunJob(fine), *runs])
+    reference = store.get(fine.key)
+    for job in runs:
+        row = store.get(job.spec.key)
+        assert row["recorded_utc"] >= reference["recorded_utc"]
+        assert math.isfinite(row["error"]) and row["error"] > 0.0

@@ -45,7 +45,7 @@ def test_crossing_fraction_rejects_a_gap_that_does_not_close():
 
 def _ball_stepper(restitution: float, localise: bool, h: float = 1e-3):
     scene = get_scene(f"bouncing-ball-e{restitution:g}")
-    settings = create().stepper_settings(
+    settings = create().run_settings(
         scene, RunSettings(time_step=h, options={"localise_impacts": localise}))
     return MoreauJeanStepper(build_system(scene), settings), initial_state(scene), scene
 
@@ -119,12 +119,12 @@ def test_settings_and_options_of_localisation_are_validated():
     scene = get_scene("bouncing-ball-e0.5")
     engine = create()
     with pytest.raises(ValueError):
-        engine.stepper_settings(scene, RunSettings(options={"localise_impacts": "yes"}))
-    assert engine.stepper_settings(scene, RunSettings()).localise_impacts
+        engine.run_settings(scene, RunSettings(options={"localise_impacts": "yes"}))
+    assert engine.run_settings(scene, RunSettings()).localise_impacts
     # Without the projection the preset's localisation does not apply; asked for, it fails.
-    assert not engine.stepper_settings(
+    assert not engine.run_settings(
         scene, RunSettings(options={"projection": False})).localise_impacts
-    assert not create("no-projection").stepper_settings(scene, RunSettings()).localise_impacts
+    assert not create("no-projection").run_settings(scene, RunSettings()).localise_impacts
     with pytest.raises(ValueError):
-        engine.stepper_settings(
+        engine.run_settings(
             scene, RunSettings(options={"projection": False, "localise_impacts": True}))

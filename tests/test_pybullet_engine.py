@@ -56,7 +56,7 @@ def test_every_library_scene_runs_or_is_unsupported(name, preset):
         assert trajectory.message
     else:
         assert len(trajectory.times) == 4
-    assert trajectory.metadata["internal_units"]
+    assert trajectory.internal_units
     for array in (trajectory.positions, trajectory.orientations, trajectory.velocities,
                   trajectory.angular_velocities):
         assert np.isfinite(array).all()
@@ -202,8 +202,8 @@ def test_internal_units_are_recorded():
     """A sub-millimetre scene runs in mm-g-ms in tuned, in SI in default (docs: Units)."""
     scene = get_scene("clearance-pendulum")
     settings = RunSettings(horizon=2 * scene.time_step)
-    assert create("tuned").run(scene, settings).metadata["internal_units"].startswith("mm")
-    assert create("default").run(scene, settings).metadata["internal_units"].startswith("m")
+    assert create("tuned").run(scene, settings).internal_units.startswith("mm")
+    assert create("default").run(scene, settings).internal_units.startswith("m-")
 
 
 # ---------------------------------------------------------------------------- traps (ENGINES.md)

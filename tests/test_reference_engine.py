@@ -223,7 +223,7 @@ def test_forced_non_convergence_is_flagged_and_reported():
     trajectory = ENGINE.run(scene, RunSettings(
         horizon=0.05, options={"method": "nsgs", "max_iterations": 1}))
     assert not trajectory.solver_converged.all()
-    assert trajectory.metadata["unconverged_steps"]
+    assert trajectory.unconverged_steps
     assert "did not converge" in trajectory.message
 
 
@@ -241,4 +241,4 @@ def test_flores_slider_crank_full_horizon(tmp_path):
     # Issue target: no penetration beyond 1e-9 m, every step converged.
     assert _figures(scene, trajectory, "no_penetration")["penetration_max"] <= 1e-9
     assert trajectory.solver_converged.all()
-    assert not trajectory.metadata["unconverged_steps"]
+    assert not trajectory.unconverged_steps

@@ -97,10 +97,10 @@ def test_unknown_options_and_presets_are_rejected():
     with pytest.raises(ValueError, match="preset"):
         siconos_engine.create("fast")
     with pytest.raises(ValueError, match="unknown siconos option"):
-        siconos_engine.create().resolved_options(get_scene("pendulum"),
+        siconos_engine.create().run_settings(get_scene("pendulum"),
                                                  RunSettings(options={"thta": 1.0}))
     with pytest.raises(ValueError, match="solver"):
-        siconos_engine.create().resolved_options(get_scene("pendulum"),
+        siconos_engine.create().run_settings(get_scene("pendulum"),
                                                  RunSettings(options={"solver": "lemke"}))
 
 
@@ -268,7 +268,7 @@ def test_flores_slider_crank_full_run_dissipates_and_stays_in_its_guide():
     scene = get_scene("flores-slider-crank")
     trajectory = siconos_engine.create().run(scene, RunSettings(record_every=10))
     assert trajectory.status is RunStatus.OK, trajectory.message
-    assert trajectory.metadata["unconverged_count"] == 0
+    assert trajectory.unconverged_count == 0
     # Impacts (e = 0.4) and friction only dissipate: no energy growth beyond round-off.
     assert _figures(scene, trajectory, "energy")["energy_growth_relative"] <= 1e-9
     # Without projection the slider enters the guide by at most one step of its transverse

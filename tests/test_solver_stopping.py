@@ -152,11 +152,11 @@ def test_reference_engine_uses_the_floor_by_default_and_counts_its_steps():
 
     scene = get_scene("incline-stick")
     engine = create()
-    assert engine.stepper_settings(scene, RunSettings()).solver.roundoff_floor
-    plain = engine.stepper_settings(scene, RunSettings(options={"roundoff_floor": False}))
+    assert engine.run_settings(scene, RunSettings()).solver.roundoff_floor
+    plain = engine.run_settings(scene, RunSettings(options={"roundoff_floor": False}))
     assert not plain.solver.roundoff_floor
     with pytest.raises(ValueError, match="roundoff_floor"):
-        engine.stepper_settings(scene, RunSettings(options={"roundoff_floor": "no"}))
+        engine.run_settings(scene, RunSettings(options={"roundoff_floor": "no"}))
     # A tolerance no residual can meet: the box's four contacts (a redundant set) converge on
     # the floor, and the run says how many steps did.
     short = RunSettings(time_step=1e-3, horizon=0.05, options={"tolerance": 1e-300})

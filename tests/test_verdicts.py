@@ -89,11 +89,22 @@ def test_a_rigid_engine_stores_no_contact_energy():
     # The same 0.1 mm and 10 N from an engine with rigid contacts (the force is an impulse
     # over the step, the depth that of a step that captured an impact): no stored energy.
     trajectory = _ball_and_plate([0.0049, 0.006], normal_forces=[10.0, 0.0])
-    trajectory.metadata["rigid_contacts"] = True
+    trajectory.rigid_contacts = True
     assert series.contact_energy(scene, trajectory).tolist() == [0.0, 0.0]
 
 
 def test_a_run_records_whether_its_engine_has_rigid_contacts():
     scene, settings = get_scene("bouncing-ball-e0.5"), RunSettings(horizon=0.01)
-    assert reference.create().run(scene, settings).metadata["rigid_contacts"] is True
-    assert mujoco.create().run(scene, settings).metadata["rigid_contacts"] is False
+    assert reference.create().run(scene, settings).rigid_contacts is True
+    assert mujoco.create().run(scene, settings).rigid_contacts is False
+
+
+def test_the_docs_show_the_criteria_table_as_the_code_has_it():
+    # docs/harness.md carries the one table of criteria (CRITERIA), as criteria_table()
+    # writes it: a criterion changed in the code without its words in the docs fails here.
+    from pathlib import Path
+
+    from clearbench.harness.measure.verdicts import CRITERIA, criteria_table
+    docs = (Path(__file__).resolve().parent.parent / "docs" / "harness.md").read_text()
+    assert criteria_table() in docs
+    assert {"bounce_apex", "no_penetration", "output_value"} <= set(CRITERIA)

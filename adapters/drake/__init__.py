@@ -25,6 +25,7 @@ HARNESS_DEFAULTS = HarnessDefaults(
     regress_runs=(*QUICK_SCENES, short_c60(ensemble=8)),
     c60_ladders={"demo": {C60_ON: {"tuned": (1e-3,)}},
                  "full": both_c60_scenes({"default": (1e-3,), "tuned": (1e-3, 2e-3, 4e-3)})},
+    c60_step_cost=9.6,
     colour="#D55E00",
 )
 

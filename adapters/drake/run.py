@@ -33,7 +33,7 @@ from pydrake.multibody.plant import ExternallyAppliedSpatialForce
 
 from clearbench.adapters.drake.build import BuiltPlant
 from clearbench.adapters.energy_guard import EnergyGuard
-from clearbench.adapters.recording import SampleRecorder
+from clearbench.adapters.step_monitor import StepMonitor
 from clearbench.adapters.trajectory import RunStatus
 from clearbench.kernels.quaternion import quat_normalize, quat_to_matrix
 from clearbench.scenarios.bodies import Motion
@@ -55,15 +55,12 @@ class Runner:
         self.config = built.settings
         self.steps = steps
         self.dt = built.time_step
-        self.recorder = SampleRecorder(len(scene.bodies), len(scene.all_contacts), steps,
-                                       record_every)
+        self.monitor = StepMonitor(scene, steps, record_every, EnergyGuard(
+            scene, self.config.energy_gain_tolerance, self.config.guard_interval,
+            counts_torsional_springs=False))
         self.time = 0.0
-        self.stepping_seconds = 0.0
-        self.steps_taken = 0
         self.max_contacts = 0
         self.penetration_max = 0.0
-        self.guard = EnergyGuard(scene, self.config.energy_gain_tolerance,
-                                 self.config.guard_interval, counts_torsional_springs=False)
         self._handles = [built.bodies.get(b.name) for b in scene.bodies]
         self._com_local = np.array([np.asarray(b.center_of_mass, float) for b in scene.bodies])
         self._fixed = {}
@@ -144,12 +141,12 @@ class Runner:
         self._force_port.FixValue(self.context, applied)
 
     def run(self) -> tuple[RunStatus, str]:
-        """Step the run, sampling into :attr:`recorder`; (status, message) of its end."""
-        recorder = self.recorder
+        """Step the run, sampling into the monitor; (status, message) of its end."""
+        monitor = self.monitor
         simulator = self.built.simulator
         state = self.body_state()
         self.store(state)
-        self.guard.start(*self.energy(state))
+        monitor.guard.start(*self.energy(state))
         simulator.Initialize()
         for k in range(1, self.steps + 1):
             tick = time.perf_counter()
@@ -159,23 +156,14 @@ class Runner:
                 simulator.AdvanceTo(k * self.dt)
             except RuntimeError as error:
                 problem = f"Drake stopped at step {k} (t = {k * self.dt:.6g} s): {error}"
-            self.stepping_seconds += time.perf_counter() - tick
+            monitor.stepping_seconds += time.perf_counter() - tick
             self.time = k * self.dt
             if problem is not None:
                 logger.info("%s: %s", self.scene.name, problem)
                 return RunStatus.DIVERGED, problem
-            self.steps_taken = k
-            recording = recorder.is_due(k)
-            state = None
-            if recording or self.guard.due(k):
-                state = self.body_state()
-                if not all(np.isfinite(x).all() for x in state):
-                    problem = f"non-finite state at step {k} (t = {self.time:.6g} s)"
-                elif self.guard.applies:
-                    problem = self.guard.check(*self.energy(state), self.time)
-            if recording or (problem is not None and not recorder.is_full):
-                self.store(state if state is not None else self.body_state(),
-                           self.contact_forces())
+            monitor.steps_taken = k
+            problem = monitor.after_step(k, self.time, self.body_state, self.energy,
+                                         lambda state: self.store(state, self.contact_forces()))
             if problem is not None:
                 logger.info("%s: stopped: %s", self.scene.name, problem)
                 return RunStatus.DIVERGED, problem
@@ -230,5 +218,5 @@ class Runner:
         """Record ``state`` (from :meth:`body_state`) as the next sample, with the step's
         contact ``forces`` (from :meth:`contact_forces`) when given."""
         position, orientation, velocity, omega, _, _ = state
-        self.recorder.store(self.time, position, orientation, velocity, omega,
-                            contacts=forces)
+        self.monitor.recorder.store(self.time, position, orientation, velocity, omega,
+                                    contacts=forces)

@@ -21,6 +21,7 @@ import dataclasses
 from dataclasses import dataclass
 
 from clearbench.adapters.options import OptionError, OptionTable, boolean, choice, integer, number
+from clearbench.adapters.primitive_pieces import PIECE_OPTIONS, PieceSettings
 
 #: Drake's own MultibodyPlantConfig defaults (pydrake 1.51: ``MultibodyPlantConfig()``).
 DRAKE_DEFAULTS = {
@@ -56,7 +57,7 @@ PRESETS: dict[str, dict] = {
 
 
 @dataclass(frozen=True)
-class DrakeSettings:
+class DrakeSettings(PieceSettings):
     """Every option of a Drake run (lengths in the model's internal units, SI).
 
     Attributes
@@ -119,12 +120,6 @@ class DrakeSettings:
     relaxation_steps: float | None = None
     sap_near_rigid_threshold: float = 1.0
     hydroelastic_boxes: bool = False
-    ring_pieces: int = 64
-    ring_piece_radius: float = 0.01
-    bore_pieces: int = 64
-    bore_piece_radius: float = 0.05
-    face_thickness: float = 0.1
-    plane_box_size: float = 100.0
     driver_armature_ratio: float = 1e6
     energy_gain_tolerance: float = 0.1
     guard_interval: int = 10
@@ -163,12 +158,7 @@ OPTIONS = OptionTable("drake", (
     number("relaxation_steps", at_least=0.0, optional=True),
     number("sap_near_rigid_threshold", at_least=0.0),
     boolean("hydroelastic_boxes"),
-    integer("ring_pieces", at_least=3),
-    number("ring_piece_radius", above=0.0),
-    integer("bore_pieces", at_least=3),
-    number("bore_piece_radius", above=0.0),
-    number("face_thickness", above=0.0),
-    number("plane_box_size", above=0.0),
+    *PIECE_OPTIONS,
     number("driver_armature_ratio", above=0.0),
     number("energy_gain_tolerance", above=0.0),
     integer("guard_interval", at_least=1),

@@ -29,6 +29,7 @@ HARNESS_DEFAULTS = HarnessDefaults(
     c60_ladders={"demo": {C60_ON: {"mechanism": (1e-3,)}},
                  "full": both_c60_scenes({"default": (1e-3,), "tuned": (1e-3,),
                                           "mechanism": (1e-3,)})},
+    c60_step_cost=98.0,
     colour="#009E73",
 )
 

@@ -75,7 +75,6 @@ class ExudynEngine(SteppingEngine):
         return {
             "exudyn_version": load_exudyn().__version__,
             "settings": config.as_dict(),
-            "units": self.units_note(scene, internal),
             "time_step_internal": built.time_step,
             "connectors": built.connector_count,
             "connectors_per_pair": {p.contact.name: len(p.connectors) for p in built.pair_plans},
@@ -84,7 +83,7 @@ class ExudynEngine(SteppingEngine):
             "contact_stiffness": built.stiffness,
             "clearance_joints": clearance_summary(scene, config),
             "warnings": list(built.warnings),
-            "guards": runner.guard_notes,
+            "guards": runner.monitor.guard.notes,
             "force_scale": runner.force_scale_value,
             "newton_absolute_tolerance": runner.newton_absolute_tolerance,
             "solver_steps": runner.solver_steps,
@@ -98,8 +97,7 @@ class ExudynEngine(SteppingEngine):
             # printed inverted (see adapters/exudyn/failure.py).
             "exudyn_error_string": runner.exudyn_error_string,
             "captured_stdout": runner.captured_stdout[-2000:],
-            "energy_initial": runner.guard.energy_initial,
-            "energy_max_gain": runner.guard.max_gain,
+            "energy_initial": runner.monitor.guard.energy_initial,
             # Exudyn does not clip the normal force at zero: the most negative recorded sum of a
             # pair (model units; 0 when none pulled).
             "min_normal_force": runner.min_normal_force,

@@ -41,7 +41,7 @@ from clearbench.adapters.energy_guard import EnergyGuard
 from clearbench.adapters.exudyn.build import BuiltSystem, load_exudyn
 from clearbench.adapters.exudyn.failure import failed_loop, failure_reason
 from clearbench.adapters.exudyn.settings import ExudynSettings
-from clearbench.adapters.recording import SampleRecorder
+from clearbench.adapters.step_monitor import StepMonitor
 from clearbench.adapters.trajectory import RunStatus
 from clearbench.kernels.quaternion import quat_from_matrix_batch, quat_to_matrix_batch
 from clearbench.scenarios.bodies import Motion
@@ -107,14 +107,15 @@ class Runner:
         self.config = config
         self.steps = steps
         self.dt = built.time_step
-        self.recorder = SampleRecorder(len(scene.bodies), len(scene.all_contacts), steps,
-                                       record_every)
+        self.monitor = StepMonitor(scene, steps, record_every, EnergyGuard(
+            scene, config.energy_gain_tolerance, config.guard_interval,
+            counts_torsional_springs=False))
+        self.recorder = self.monitor.recorder
         # Reduced steps make Exudyn's time leave the grid: a sample is the first step end at
         # or after its time.
         self.record_times = np.asarray(self.recorder.schedule, dtype=float) * self.dt
         self.min_normal_force = 0.0
         self.solver_steps = 0
-        self.stepping_seconds = 0.0
         self.record_seconds = 0.0
         self.problem: str | None = None
         self.captured_stdout = ""
@@ -129,9 +130,6 @@ class Runner:
         self.gravity = np.asarray(scene.gravity, dtype=float)
         self._springs = [(load, scene.body_index(load.body_a), scene.body_index(load.body_b))
                          for load in scene.loads if isinstance(load, LinearSpringDamper)]
-        self.guard = EnergyGuard(scene, config.energy_gain_tolerance, config.guard_interval,
-                                 counts_torsional_springs=False)
-        self.guard_notes = self.guard.notes
         self._newton_count = 0
         self._last_newton = 0
         self._discontinuous_failures = 0
@@ -306,13 +304,10 @@ class Runner:
             self.built.law_forces.remember(rotation)
         recording = (self.count < len(self.record_times)
                      and t >= self.record_times[self.count] - 1e-6 * self.dt)
-        checking = self.guard.due(self.solver_steps)
-        if recording or checking or problem is not None:
-            state = self.state()
-            if self.guard.applies and problem is None:
-                problem = self.guard.check(*self.energy(state), t)
-            if (recording or problem is not None) and not self.recorder.is_full:
-                self.store(t, state)
+        problem = self.monitor.after_step(
+            self.solver_steps, t, self.state, self.energy, lambda state: self.store(t, state),
+            recording=recording, checking=self.monitor.guard.due(self.solver_steps),
+            problem=problem)
         self.record_seconds += time.perf_counter() - tick
         if problem is not None:
             self.problem = problem
@@ -326,7 +321,7 @@ class Runner:
         closed_loop = "closed_loop" in self.scene.features
         s = simulation_settings(self.config, self.dt, self.steps, closed_loop)
         if closed_loop and self.config.closed_loop_full_pivot:
-            self.guard_notes.append("closed loop: EigenDense full-pivot LU with "
+            self.monitor.guard.notes.append("closed loop: EigenDense full-pivot LU with "
                                     "ignoreSingularJacobian (redundant constraints)")
         state = self.state()
         if self.config.newton_force_tolerance is not None:
@@ -335,7 +330,7 @@ class Runner:
                 s.timeIntegration.newton.absoluteTolerance = (
                     self.config.newton_force_tolerance * self.force_scale_value)
         self.newton_absolute_tolerance = s.timeIntegration.newton.absoluteTolerance
-        self.guard.start(*self.energy(state))
+        self.monitor.guard.start(*self.energy(state))
         self.store(0.0, state, with_contacts=False)
         mbs.SetPostStepUserFunction(self._post_step)
         if self.built.law_forces is not None and self.config.law_loads == "implicit":
@@ -386,7 +381,7 @@ class Runner:
         finally:
             exu.config.printToConsole = previous
             self.captured_stdout = buffer.getvalue()
-        self.stepping_seconds = time.perf_counter() - tick - self.record_seconds
+        self.monitor.stepping_seconds = time.perf_counter() - tick - self.record_seconds
         if status is not RunStatus.OK:
             # keep the state where it stopped as the last sample
             recorder = self.recorder

@@ -25,6 +25,7 @@ HARNESS_DEFAULTS = HarnessDefaults(
                           C60_TRIP: {"tuned": (1e-3, 4e-3)}},
                  "full": both_c60_scenes({"default": (1e-3, 4e-3),
                                           "tuned": (1e-3, 2e-3, 4e-3, 8e-3)})},
+    c60_step_cost=0.32,
     colour="#0072B2",
 )
 

@@ -87,11 +87,10 @@ class MujocoEngine(SteppingEngine):
         return {
             "mujoco_version": runner.mujoco.__version__,
             "settings": config.as_dict(),
-            "units": self.units_note(scene, internal),
             "time_step_internal": built.model.opt.timestep,
             "time_step_scene": built.model.opt.timestep / to_internal,
             "warnings": list(built.warnings) + runner.warnings,
-            "guards": runner.guard_notes,
+            "guards": runner.monitor.guard.notes,
             "contact_solref": [list(p.solref) for p in built.contact_parameters],
             "contact_dampratio": [p.damping_ratio for p in built.contact_parameters],
             "rings": ring_summary(scene, config),
@@ -103,10 +102,7 @@ class MujocoEngine(SteppingEngine):
             "initial_velocity_residual": built.initial_velocity_residual
             * internal.units.factor_to(scene.units, VELOCITY),
             "mujoco_warnings": runner.mujoco_warnings,
-            "energy_initial": runner.energy_initial,
-            "energy_max_gain": runner.energy_max_gain,
-            "unconverged_steps": runner.unconverged[:1000],
-            "unconverged_count": len(runner.unconverged),
+            "energy_initial": runner.monitor.guard.energy_initial,
             "max_contacts": runner.max_contacts,
         }
 

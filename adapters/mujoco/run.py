@@ -16,7 +16,7 @@ import numpy as np
 
 from clearbench.adapters.energy_guard import EnergyGuard
 from clearbench.adapters.mujoco.settings import MujocoSettings
-from clearbench.adapters.recording import SampleRecorder
+from clearbench.adapters.step_monitor import StepMonitor
 from clearbench.adapters.trajectory import RunStatus
 from clearbench.kernels.time_profiles import evaluate_profile_slope
 from clearbench.scenarios.energy import mechanical_energy
@@ -41,12 +41,7 @@ class Runner:
         self.model, self.data = built.model, built.data
         model = self.model
         self.dt = model.opt.timestep
-        self.recorder = SampleRecorder(len(scene.bodies), len(scene.all_contacts), steps,
-                                       record_every)
         self.ids = built.body_ids
-        self.stepping_seconds = 0.0
-        self.steps_taken = 0
-        self.unconverged: list[int] = []
         self.warnings: list[str] = []
         self.mujoco_warnings: dict[str, int] = {}
         self.max_contacts = 0
@@ -54,8 +49,8 @@ class Runner:
         self._site_ids = [(model.site(f"{s.name}:a").id, model.site(f"{s.name}:b").id)
                           for s in self._springs]
         self._hinge_springs = built.hinge_springs
-        self.guard = EnergyGuard(scene, config.energy_gain_tolerance, config.guard_interval)
-        self.guard_notes = self.guard.notes
+        self.monitor = StepMonitor(scene, steps, record_every, EnergyGuard(
+            scene, config.energy_gain_tolerance, config.guard_interval))
         step_times = np.arange(steps + 1) * self.dt
         self._drive = []
         for dof in built.driven:
@@ -98,6 +93,11 @@ class Runner:
         mj.mj_comPos(self.model, self.data)
         mj.mj_comVel(self.model, self.data)
 
+    def _refreshed_state(self):
+        """:meth:`body_state` after :meth:`refresh_kinematics`."""
+        self.refresh_kinematics()
+        return self.body_state()
+
     def body_state(self):
         """Body-frame poses, centre-of-mass velocities (world) and angular velocities (body
         axes) of every scene body: (nb, 3), (nb, 4), (nb, 3), (nb, 3)."""
@@ -127,17 +127,6 @@ class Runner:
         energy = mechanical_energy(self.scene, d.xipos[ids], velocity, omega, spring_points,
                                    torsion)
         return float(energy.total), float(energy.kinetic)
-
-    def check_energy(self) -> str | None:
-        return self.guard.check(*self.energy(), self.data.time)
-
-    @property
-    def energy_initial(self) -> float:
-        return self.guard.energy_initial
-
-    @property
-    def energy_max_gain(self) -> float:
-        return self.guard.max_gain
 
     # ------------------------------------------------------------------ loads
     def apply_loads(self) -> None:
@@ -187,13 +176,13 @@ class Runner:
 
     # ------------------------------------------------------------------ loop
     def run(self) -> tuple[RunStatus, str]:
-        """Step the run, sampling into :attr:`recorder`; (status, message) of its end."""
+        """Step the run, sampling into the monitor; (status, message) of its end."""
         mj = self.mujoco
         model, data = self.model, self.data
-        recorder = self.recorder
+        monitor = self.monitor
         self.refresh_kinematics()
         self.store()
-        self.guard.start(*self.energy())
+        monitor.guard.start(*self.energy())
         iterations_cap = model.opt.iterations
         for k in range(1, self.steps + 1):
             tick = time.perf_counter()
@@ -204,32 +193,21 @@ class Runner:
             mj.mj_step1(model, data)
             self.apply_loads()
             mj.mj_step2(model, data)
-            self.stepping_seconds += time.perf_counter() - tick
-            self.steps_taken = k
+            monitor.stepping_seconds += time.perf_counter() - tick
+            monitor.steps_taken = k
             islands = min(max(int(data.nisland), 1), len(data.solver_niter))
             niter = int(data.solver_niter[:islands].max())
-            recorder.accumulate(niter, converged=niter < iterations_cap)
-            if niter >= iterations_cap:
-                self.unconverged.append(k)
+            monitor.solver_step(k, niter, converged=niter < iterations_cap)
             self.max_contacts = max(self.max_contacts, int(data.ncon))
             problem = self._check_warnings()
             if problem is None and not (np.isfinite(data.qpos).all()
                                         and np.isfinite(data.qvel).all()):
                 problem = f"non-finite state at step {k} (t = {data.time:.6g})"
-            recording = recorder.is_due(k)
-            checking = self.guard.due(k)
-            if problem is None and (recording or checking):
-                forces = self.contact_forces() if recording else None
-                self.refresh_kinematics()
-                if self.guard.applies:
-                    problem = self.check_energy()
-                if recording:
-                    self.store(forces)
-            elif problem is not None and not recorder.is_full:
-                # Keep the offending state as the last sample.
-                forces = self.contact_forces()
-                self.refresh_kinematics()
-                self.store(forces)
+            # Kinematics refreshed before reading the state (mj_step leaves them one step
+            # old); the contact forces, read at storing, are not touched by the refresh.
+            problem = monitor.after_step(
+                k, data.time, self._refreshed_state, lambda state: self.energy(),
+                lambda state: self.store(self.contact_forces()), problem=problem)
             if problem is not None:
                 logger.info("%s: stopped: %s", self.scene.name, problem)
                 return RunStatus.DIVERGED, problem
@@ -283,5 +261,5 @@ class Runner:
         :meth:`contact_forces`), the step's solver statistics and own residual too."""
         position, orientation, velocity, omega = self.body_state()
         residual = self.solver_residual() if forces is not None else None
-        self.recorder.store(self.data.time, position, orientation, velocity, omega,
-                            contacts=forces, residual=residual)
+        self.monitor.recorder.store(self.data.time, position, orientation, velocity, omega,
+                                    contacts=forces, residual=residual)

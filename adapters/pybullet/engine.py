@@ -84,14 +84,12 @@ class PybulletEngine(SteppingEngine):
         return {
             "pybullet_version": installed_package("pybullet")[1],
             "settings": config.as_dict(),
-            "units": self.units_note(scene, internal),
-            "internal_units": internal.units.describe(),
             "time_step_internal": built.time_step,
             "time_step_scene": built.time_step / to_internal,
             "collision_margin_internal": built.margin,
             "contact_breaking_threshold_set": config.contact_breaking_threshold,
             "warnings": list(built.warnings),
-            "guards": runner.guard.notes,
+            "guards": runner.monitor.guard.notes,
             "static_bodies": list(topology.static),
             "rigid_bodies": list(topology.rigid),
             "multibodies": [[link.body for link in tree.links] for tree in topology.trees],
@@ -100,10 +98,7 @@ class PybulletEngine(SteppingEngine):
             "rings": ring_summary(internal, config),
             "initial_velocity_residual": built.initial_velocity_residual
             * internal.units.factor_to(scene.units, VELOCITY),
-            "energy_initial": runner.guard.energy_initial,
-            "energy_max_gain": runner.guard.max_gain,
-            "unconverged_steps": runner.unconverged[:1000],
-            "unconverged_count": len(runner.unconverged),
+            "energy_initial": runner.monitor.guard.energy_initial,
             "max_contacts": runner.max_contacts,
         }
 

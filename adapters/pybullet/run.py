@@ -30,7 +30,7 @@ from clearbench.adapters.energy_guard import EnergyGuard
 from clearbench.adapters.pybullet.frames import from_pb
 from clearbench.adapters.pybullet.library import pb
 from clearbench.adapters.pybullet.world import BuiltWorld
-from clearbench.adapters.recording import SampleRecorder
+from clearbench.adapters.step_monitor import StepMonitor
 from clearbench.adapters.trajectory import RunStatus
 from clearbench.kernels.quaternion import quat_conjugate, quat_multiply, quat_to_matrix
 from clearbench.scenarios.bodies import Motion
@@ -48,15 +48,11 @@ class Runner:
         self.config = built.settings
         self.steps = steps
         self.dt = built.time_step
-        self.recorder = SampleRecorder(len(scene.bodies), len(scene.all_contacts), steps,
-                                       record_every)
+        self.monitor = StepMonitor(scene, steps, record_every, EnergyGuard(
+            scene, self.config.energy_gain_tolerance, self.config.guard_interval,
+            counts_torsional_springs=False))
         self.time = 0.0
-        self.stepping_seconds = 0.0
-        self.steps_taken = 0
-        self.unconverged: list[int] = []
         self.max_contacts = 0
-        self.guard = EnergyGuard(scene, self.config.energy_gain_tolerance,
-                                 self.config.guard_interval, counts_torsional_springs=False)
         # Static bodies never move: their poses are the scene's.
         self._static_pose = {i: (np.asarray(b.position, float),
                                  np.asarray(b.orientation, float) / np.linalg.norm(
@@ -143,9 +139,6 @@ class Runner:
                                    rigid_spring_points(self.scene, position, rotation))
         return float(energy.total), float(energy.kinetic)
 
-    def check_energy(self, state) -> str | None:
-        return self.guard.check(*self.energy(state), self.time)
-
     def check_motors(self) -> str | None:
         """A free joint whose default motor was left on acts with a non-zero motor torque."""
         for pb_body, joint, kind in self.built.free_joints:
@@ -185,33 +178,24 @@ class Runner:
                                    pb.WORLD_FRAME, physicsClientId=client)
 
     def run(self) -> tuple[RunStatus, str]:
-        """Step the run, sampling into :attr:`recorder`; (status, message) of its end."""
-        recorder = self.recorder
+        """Step the run, sampling into the monitor; (status, message) of its end."""
+        monitor = self.monitor
         state = self.body_state()
         self.store(state)
-        self.guard.start(*self.energy(state))
+        monitor.guard.start(*self.energy(state))
         client = self.client
         for k in range(1, self.steps + 1):
             tick = time.perf_counter()
             self.apply_loads(k)
             analytics = pb.stepSimulation(physicsClientId=client)
-            self.stepping_seconds += time.perf_counter() - tick
+            monitor.stepping_seconds += time.perf_counter() - tick
             self.time = k * self.dt
-            self.steps_taken = k
+            monitor.steps_taken = k
             self._solver(analytics, k)
-            problem = self.check_motors() if k == 1 else None
-            recording = recorder.is_due(k)
-            state = None
-            if problem is None and (recording or self.guard.due(k)):
-                state = self.body_state()
-                if not all(np.isfinite(x).all() for x in state):
-                    problem = f"non-finite state at step {k} (t = {self.time:.6g})"
-                elif self.guard.applies:
-                    problem = self.check_energy(state)
-            if recording or (problem is not None and not recorder.is_full):
-                # A stopped run keeps the offending state as its last sample.
-                self.store(state if state is not None else self.body_state(),
-                           self.contact_forces())
+            problem = monitor.after_step(
+                k, self.time, self.body_state, self.energy,
+                lambda state: self.store(state, self.contact_forces()),
+                problem=self.check_motors() if k == 1 else None)
             if problem is not None:
                 logger.info("%s: stopped: %s", self.scene.name, problem)
                 return RunStatus.DIVERGED, problem
@@ -227,9 +211,7 @@ class Runner:
         residual = max(float(island["remainingResidual"]) for island in analytics)
         converged = not (iterations >= self.config.num_solver_iterations
                          and residual > self.config.solver_residual_threshold)
-        self.recorder.accumulate(iterations, converged, residual)
-        if not converged:
-            self.unconverged.append(k)
+        self.monitor.solver_step(k, iterations, converged, residual)
 
     # ------------------------------------------------------------------ read-out
     def contact_forces(self) -> tuple[np.ndarray, np.ndarray, int]:
@@ -260,5 +242,5 @@ class Runner:
         """Record ``state`` (from :meth:`body_state`) as the next sample, with the step's
         contact ``forces`` (from :meth:`contact_forces`) and solver statistics when given."""
         position, orientation, velocity, omega, _, _ = state
-        self.recorder.store(self.time, position, orientation, velocity, omega,
-                            contacts=forces)
+        self.monitor.recorder.store(self.time, position, orientation, velocity, omega,
+                                    contacts=forces)

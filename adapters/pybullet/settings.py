@@ -43,6 +43,7 @@ import dataclasses
 from dataclasses import dataclass
 
 from clearbench.adapters.options import OptionTable, boolean, choice, integer, number
+from clearbench.adapters.primitive_pieces import PIECE_OPTIONS, PieceSettings
 
 #: Compound shapes of PyBullet keep at most this many children (MAX_COMPOUND_COLLISION_SHAPES of
 #: SharedMemoryCommands.h); more are dropped silently (docs/engines/pybullet.md).
@@ -71,7 +72,7 @@ PRESETS: dict[str, dict] = {
 
 
 @dataclass(frozen=True)
-class PybulletSettings:
+class PybulletSettings(PieceSettings):
     """Every option of a PyBullet run (internal units, SI by default).
 
     Attributes
@@ -135,21 +136,10 @@ class PybulletSettings:
         ``collision_margin``).
     switch_off_joint_motors : bool
         Switch off the default velocity motor of every joint that is not driven.
-    ring_pieces : int
-        Spheres per full circle of a ring (circle or arc shape).
-    ring_piece_radius : float
-        Least radius of a ring sphere relative to the ring radius (a pair's positive offset
-        gives larger spheres); capped at half the radial clearance of a clearance joint.
-    bore_pieces : int
-        Capsules per full circle lining a bore.
-    bore_piece_radius : float
-        Radius of the bore capsules relative to the bore radius.
-    face_thickness : float
-        Thickness of the box (rectangle) or cylinder (disc) standing in for a bounded face
-        without ``depth``, relative to its larger half extent (or radius).
-    plane_box_size : float
-        Half size of the box standing in for a plane on a moving body, relative to the scene's
-        largest length.
+    ring_pieces, ring_piece_radius, bore_pieces, bore_piece_radius, face_thickness,
+    plane_box_size
+        Rings, bores and bounded faces from primitives
+        (:class:`clearbench.adapters.primitive_pieces.PieceSettings`).
     closure_spacing : float or None
         Distance between the two point-to-point constraints of a loop-closing revolute joint
         [L]; None: the larger radius of gyration of the two bodies.
@@ -192,12 +182,6 @@ class PybulletSettings:
     collision_margin: float | None = None
     collision_margin_relative: float | None = None
     switch_off_joint_motors: bool = True
-    ring_pieces: int = 64
-    ring_piece_radius: float = 0.01
-    bore_pieces: int = 64
-    bore_piece_radius: float = 0.05
-    face_thickness: float = 0.1
-    plane_box_size: float = 100.0
     closure_spacing: float | None = None
     driver_max_force: float = 1e6
     internal_units: str = "SI"
@@ -238,12 +222,7 @@ OPTIONS = OptionTable("pybullet", (
     number("collision_margin", above=0.0, optional=True),
     number("collision_margin_relative", above=0.0, optional=True),
     boolean("switch_off_joint_motors"),
-    integer("ring_pieces", at_least=3),
-    number("ring_piece_radius", above=0.0),
-    integer("bore_pieces", at_least=3),
-    number("bore_piece_radius", above=0.0),
-    number("face_thickness", above=0.0),
-    number("plane_box_size", above=0.0),
+    *PIECE_OPTIONS,
     number("closure_spacing", above=0.0, optional=True),
     number("driver_max_force", above=0.0),
     choice("internal_units", ("SI", "scene", "mm-g-ms", "auto")),

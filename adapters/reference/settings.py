@@ -18,7 +18,7 @@ Options (``RunSettings.options``) override: ``theta``, ``projection``, ``method`
 with e > 0 is applied at its crossing time within the step instead of over the whole step,
 which takes the bouncing-ball apex errors at h = 1e-3 s from 8e-3 to 2e-5),
 ``roundoff_floor`` and ``step_loop`` (``auto``, ``python`` or ``compiled``:
-:mod:`.step_loop`); see :class:`~clearbench.ref_solver.stepper.StepperSettings`.
+:mod:`.run`); see :class:`~clearbench.ref_solver.stepper.StepperSettings`.
 """
 
 from __future__ import annotations

@@ -22,6 +22,7 @@ HARNESS_DEFAULTS = HarnessDefaults(
     c60_ladders={"demo": {C60_ON: {"default": (1e-2,), "projection": (1e-2,)}},
                  "full": both_c60_scenes({"default": (1e-3, 2e-3, 1e-2), "nsn-ac": (1e-3,),
                                           "projection": (1e-3,)})},
+    c60_step_cost=53.0,
     colour="#CC79A7",
 )
 

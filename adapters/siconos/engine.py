@@ -101,7 +101,7 @@ class SiconosEngine(ModuleEngine):
     CAPABILITIES = capabilities
     RESOLVE_SETTINGS = staticmethod(resolve_settings)
 
-    def resolved_options(self, scene: Scene, settings: RunSettings) -> dict:
+    def run_settings(self, scene: Scene, settings: RunSettings) -> dict:
         """The settings of a run of ``scene`` (options checked against :data:`OPTIONS`):
         :func:`~.settings.resolve_options`."""
         self.check_options(settings.options)
@@ -109,7 +109,7 @@ class SiconosEngine(ModuleEngine):
 
     # ------------------------------------------------------------------ run
     def _run(self, scene: Scene, settings: RunSettings) -> Trajectory:
-        options = self.resolved_options(scene, settings)
+        options = self.run_settings(scene, settings)
         h = settings.time_step or scene.time_step
         horizon = settings.horizon or scene.horizon
         worker_settings = {key: options[key] for key in options if key != "timeout"}
@@ -151,6 +151,9 @@ class SiconosEngine(ModuleEngine):
             engine=self.name, preset=self.preset, **scene_fields(scene), time_step=h, **arrays,
             build_seconds=float(data["build_seconds"]),
             stepping_seconds=float(data["stepping_seconds"]), steps=int(data["steps"]),
-            status=status, message=str(data["message"]), metadata=metadata,
+            status=status, message=str(data["message"]),
+            unconverged_steps=tuple(metadata.pop("unconverged_steps", ())),
+            unconverged_count=int(metadata.pop("unconverged_count", 0)),
+            internal_units=scene.units.describe(), metadata=metadata,
         )
 

@@ -23,7 +23,8 @@ DEFAULTS: dict = {
     "projection_max_iterations": 50,
     "projection_solver": "enum",
     "contact_frame": "shared",
-    # GenericMechanical's handling of equality rows (iparam ISREDUCED), see resolved_options.
+    # GenericMechanical's handling of equality rows (iparam ISREDUCED), see
+    # SiconosEngine.run_settings.
     "gmp_reduction": "auto",
     "timeout": 3600.0,
     "fault": "",

@@ -31,7 +31,7 @@ class Run:
 
     @property
     def unconverged(self) -> list:
-        return list(self.trajectory.metadata.get("unconverged_steps", []))
+        return list(self.trajectory.unconverged_steps)
 
     @functools.cached_property
     def penetration(self) -> float:

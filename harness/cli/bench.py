@@ -232,7 +232,7 @@ def bench_flores_reference(args: argparse.Namespace) -> int:
     trajectory.save(out)
     print(f"Flores-Leine-Glocker slider-crank, reference engine, h = 1e-5 s, 0.2 s: "
           f"{trajectory.steps} steps in {trajectory.stepping_seconds:.1f} s, "
-          f"unconverged steps: {len(trajectory.metadata['unconverged_steps'])}")
+          f"unconverged steps: {trajectory.unconverged_count}")
     for result in results:
         print(f"  {result.name}: " + ", ".join(f"{k} = {v:.3e}" for k, v in result.figures.items()))
     print(f"trajectory (every 10th step): {out}")

@@ -202,9 +202,9 @@ def run_angles(args: argparse.Namespace) -> int:
     return 0
 
 
-def run_c60_plan(plan_name: str, labels, modules, args, store) -> set[str]:
-    """Validate and run the plan's C-60 runs (``labels``: only these engine labels); print
-    the labels left out and why, then the cross-engine figures. Returns the run keys."""
+def c60_plan_specs(plan_name: str, labels, modules) -> list:
+    """The plan's C-60 runs (``labels``: only these engine labels), longest expected first;
+    print the labels left out and why (UserError for a plan the engines declare wrongly)."""
     try:
         plan = c60_plan(plan_name, modules)
         engines, left_out = plan_engines(plan, labels, modules)
@@ -214,6 +214,13 @@ def run_c60_plan(plan_name: str, labels, modules, args, store) -> set[str]:
     for label, reason in left_out.items():
         print(f"C-60 {plan.name}: {label} left out: {reason}")
     print(f"C-60 {plan.name} ({plan.description}): {len(specs)} runs")
+    return specs
+
+
+def run_c60_plan(plan_name: str, labels, modules, args, store) -> set[str]:
+    """Validate and run the plan's C-60 runs (``labels``: only these engine labels); print
+    the labels left out and why, then the cross-engine figures. Returns the run keys."""
+    specs = c60_plan_specs(plan_name, labels, modules)
     runner = make_runner(args, store, len(specs))
     outcome = runner.run_all(specs)
     print(f"C-60: {len(outcome.ran)} runs done, {len(outcome.skipped)} reused from the store")

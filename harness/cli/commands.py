@@ -43,6 +43,8 @@ COMMANDS: dict[str, Command] = {
                      "with Siconos)"),
     "bench": Command("bench", "run a benchmark (prints figures, asserts nothing)"),
     "c60": Command("c60", "C-60 circuit breaker: validation against the published figures"),
+    "compile": Command("compile_kernels", "compile the numba kernels into this checkout's "
+                       "cache, in parallel"),
     "campaign": Command("campaign", "tolerance studies: Monte Carlo / quasi-Monte Carlo over "
                         "scene parameters, resumable, on Dask"),
 }

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import time
 
-from clearbench.harness.cli.c60 import run_c60_plan
+from clearbench.harness.cli.c60 import c60_plan_specs, print_c60
 from clearbench.harness.cli.commands import command_help
 from clearbench.harness.cli.common import (
     UserError,
@@ -115,12 +115,16 @@ def run_compare(args: argparse.Namespace) -> int:
     plan = plan_sweep(scenes, engines, parse_ladder(args.dt), timeout=args.timeout,
                       reference=reference, fine_factor=FINE_FACTOR, campaign="compare")
     stiff = plan_stability(engines, timeout=args.timeout) if args.stability else []
+    c60 = (c60_plan_specs(args.c60, [e.label for e in engines] if args.engines else None,
+                          modules) if args.c60 != "none" else [])
     store = open_store(args)
     labels = ", ".join(e.label for e in engines)
     print(f"Comparing {labels} on {len(scenes)} scenes (ladder {args.dt}"
-          + (", and the stiff suite" if stiff else "") + f"), store {store.directory}")
-    runner = make_runner(args, store, len(plan.all_specs) + len(stiff))
-    outcome = execute_plan(plan, runner)
+          + (", and the stiff suite" if stiff else "") + (", and the C-60" if c60 else "")
+          + f"), store {store.directory}")
+    # One batch, the C-60's longest runs first: they run beside the scenes' short ones.
+    runner = make_runner(args, store, len(c60) + len(plan.all_specs) + len(stiff))
+    outcome = execute_plan(plan, runner, before=c60)
     if stiff:
         more = runner.run_all(stiff)
         outcome.ran += more.ran
@@ -129,10 +133,9 @@ def run_compare(args: argparse.Namespace) -> int:
           f"{time.monotonic() - start:.0f} s")
     print_work_precision(store, [s.scene.name for s in plan.all_specs],
                          {s.key for s in plan.all_specs})
-    if args.c60 != "none":
+    if c60:
         print()
-        run_c60_plan(args.c60, [e.label for e in engines] if args.engines else None, modules,
-                     args, store)
+        print_c60(store, {s.key for s in c60})
     paths = write_report(store, args.out, engine_modules=modules)
     print(f"\nreport: {paths['html']}\nsummary: {paths['markdown']} "
           f"({time.monotonic() - start:.0f} s in all)")

@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import argparse
+import json
+import os
 import sys
 import textwrap
 
+import clearbench
 from clearbench.adapters import all_availability
 from clearbench.harness.cli.commands import command_help
 from clearbench.harness.cli.errors import UserError
@@ -72,17 +75,45 @@ def run_list(args: argparse.Namespace) -> int:
         tags = sorted({t for e in SCENES.values() for t in e.tags})
         raise UserError(f"no scene has tag {args.tag!r}; tags: {', '.join(tags)}")
     print(f"Scenes ({len(names)}):")
+    features_of = scene_features(names)
     for name in names:
         entry = get_entry(name)
-        scene = entry.build()
         print(f"  {name:<22} {entry.summary}")
         print(f"  {'':<22} tags: {', '.join(entry.tags)}")
-        features = ", ".join(sorted(scene.features)) or "(none)"
+        features = ", ".join(features_of[name]) or "(none)"
         for line in textwrap.wrap(f"features: {features}", 74):
             print(f"  {'':<22} {line}")
     print()
     print_engines()
     return 0
+
+
+#: File of the registered scenes' features in :func:`clearbench.checkout_cache_dir`.
+FEATURES_FILE = "scene-features.json"
+
+
+def scene_features(names: list[str]) -> dict[str, list[str]]:
+    """Name -> sorted features of the registered scenes ``names``. Building a scene to derive
+    them takes seconds for the C-60's (its CAD primitives), so they are kept in the cache
+    directory of this checkout and source state, which a change of the scenes' sources
+    replaces: only scenes not found there are built (and added)."""
+    path = clearbench.checkout_cache_dir() / FEATURES_FILE
+    try:
+        cached = json.loads(path.read_text())
+    except (OSError, ValueError):
+        cached = {}
+    missing = [name for name in names if name not in cached]
+    for name in missing:
+        cached[name] = sorted(get_entry(name).build().features)
+    if missing:
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            partial = path.with_suffix(f".{os.getpid()}.tmp")
+            partial.write_text(json.dumps(cached, indent=1, sort_keys=True))
+            partial.replace(path)
+        except OSError:  # a read-only cache only costs the builds next time
+            pass
+    return {name: cached[name] for name in names}
 
 
 def check_round_trip(scene: Scene, where: str) -> None:

@@ -370,7 +370,7 @@ def contact_energy(scene: Scene, trajectory: Trajectory) -> np.ndarray:
     if not scene.all_contacts or trajectory.contact_normal_force.shape != (
             count, len(scene.expanded.contacts)):
         return np.zeros(count)
-    if trajectory.metadata.get("rigid_contacts"):
+    if trajectory.rigid_contacts:
         # A nonsmooth engine's recorded force is an impulse over the step: times the
         # penetration of a step that captured an impact, it is no stored energy (it read as a
         # 34 % energy gain of Siconos's bouncing ball, whose contact-free energy is exact).

@@ -18,33 +18,10 @@ unsupported      ∅       the engine cannot represent the scene (it says why)
 ===============  ======  ===============================================================
 
 :func:`clearbench.harness.measure.expectation_figures.evaluate` states figures, not verdicts:
-what is acceptable depends on the use. These are the harness's criteria (shown in the report), each
-relative to a scale of the scene so that they hold in any unit system:
-
-=========================  ============================================================
-kind                        passes when
-=========================  ============================================================
-bounce_apex                 every resolved apex within 5 % of e^(2k) h0
-incline_stick, sticks       displacement <= 1e-4 of the body's size
-incline_slide               acceleration within 2 % of g (sin - mu cos)
-sliding_stop                stop distance within 2 % of v0^2 / (2 mu g); stopped (speed
-                            <= 1e-3 v0) and slides <= 1e-4 of its size after the stop
-rolling_incline             distance within 2 % of a t^2 / 2, a = g sin / (1 + I/(m r^2));
-                            slip speed <= 1 % of the final speed a T
-rolling_transition          final speed within 2 % of 5 v0 / 7
-pendulum                    period within 1 % and energy drift <= 1 % of m g d
-torque_free                 angular momentum drift <= 1 % of |L0|
-slider_crank                slider position within 1 % of the crank length
-rocking_ratio               first-impact ratio within 5 % of 1 - 1.5 sin^2(alpha)
-approaches_ideal            clearance excess <= one radial clearance
-energy_non_increasing       energy growth <= 1 % of the energy scale
-energy_balance              the same, on every run whose scene's energy balance is computed
-                            (no driver, point force, moment or law load): implied, not listed
-output_value                |y - expected| <= absolute + relative x |expected| tolerance
-energy_conserved            energy drift <= 1 % of the energy scale
-no_penetration              penetration <= 1 % of the smallest contact feature (radius,
-                            half-extent or radial clearance)
-=========================  ============================================================
+what is acceptable depends on the use. The harness's criteria, each relative to a scale of the
+scene so that they hold in any unit system, are one table, :data:`CRITERIA` (expectation kind
+-> what passes, in words, and the rule that judges it); :func:`criteria_table` writes it for
+the docs and the report.
 
 The headline error of a run where the scene has an analytic reference is the largest of
 :data:`ANALYTIC_ERROR` over its expectations (a relative number).
@@ -53,6 +30,7 @@ The headline error of a run where the scene has an analytic reference is the lar
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from clearbench.scenarios.scales import body_size, smallest_contact_feature
@@ -181,99 +159,211 @@ def unit_text(scene: Scene, dimension: tuple[int, int, int]) -> str:
     return " ".join(up or ["1"]) + ("/" + " ".join(down) if down else "")
 
 
+@dataclass(frozen=True)
+class _Case:
+    """What a criterion judges: the scene, the expectation's body, its figures and the
+    scene's :class:`~clearbench.scenarios.expectations.Expectation` (None when implied)."""
+
+    scene: Scene
+    body: str | None
+    figures: dict
+    expectation: object = None
+
+    def get(self, name: str, default=None):
+        return self.figures.get(name, default)
+
+    @property
+    def length(self) -> str:
+        return self.scene.units.length
+
+    def stick_bound(self) -> float:
+        """:data:`STICK_FRACTION` of the body's size [L]."""
+        return STICK_FRACTION * body_size(self.scene.body(self.body))
+
+
+#: (passed or None, detail, criterion) of one judged expectation.
+Judged = tuple
+
+
+def _bounce_apex(case: _Case) -> Judged:
+    return (*_percent("apex error", case.get("apex_max_relative_error"), 0.05),
+            "apex within 5 %")
+
+
+def _sticks(case: _Case) -> Judged:
+    bound = case.stick_bound()
+    return (*_bounded("displacement", case.get("displacement"), bound, case.length),
+            f"displacement <= {bound:.3g}")
+
+
+def _incline_slide(case: _Case) -> Judged:
+    return (*_percent("acceleration error", case.get("acceleration_relative_error"), 0.02),
+            "acceleration within 2 %")
+
+
+def _sliding_stop(case: _Case) -> Judged:
+    bound = case.stick_bound()
+    stop = case.get("stop_time")
+    parts = [_percent("stop distance error", analytic_error("sliding_stop", case.figures),
+                      0.02)]
+    if stop is None or not math.isfinite(stop):
+        parts.append((False, "never stopped"))
+    else:
+        parts.append(_bounded(f"slid after the stop at {_number(stop)} "
+                              f"{case.scene.units.time}", case.get("slide_after_stop"), bound,
+                              case.length))
+    return (*_all(parts), f"stop distance within 2 %, then sticks (slides <= {bound:.3g})")
+
+
+def _rolling_transition(case: _Case) -> Judged:
+    return (*_percent("final speed error", case.get("final_speed_relative_error"), 0.02),
+            "final speed within 2 %")
+
+
+def _rolling_incline(case: _Case) -> Judged:
+    speed = case.get("expected_final_speed")
+    bound = ROLLING_SLIP_FRACTION * speed if speed is not None else math.nan
+    passed, detail = _all([
+        _percent("distance error", case.get("distance_relative_error"), 0.02),
+        _bounded("slip speed", case.get("slip_speed_max"), bound,
+                 f"{case.length}/{case.scene.units.time}")])
+    return passed, detail, (f"distance within 2 % of a t^2 / 2, slip <= "
+                            f"{_number(100 * ROLLING_SLIP_FRACTION)} % of the final speed")
+
+
+def _pendulum(case: _Case) -> Judged:
+    return (*_all([_percent("period error", case.get("period_relative_error"), 0.01),
+                   _percent("energy drift", case.get("energy_drift"), 0.01)]),
+            "period within 1 %, energy drift <= 1 %")
+
+
+def _torque_free(case: _Case) -> Judged:
+    return (*_percent("momentum drift", case.get("angular_momentum_drift"), 0.01),
+            "momentum drift <= 1 %")
+
+
+def _slider_crank(case: _Case) -> Judged:
+    return (*_percent("slider error", case.get("slider_position_relative_error"), 0.01),
+            "slider position within 1 % of the crank")
+
+
+def _rocking_ratio(case: _Case) -> Judged:
+    return (*_percent("impact ratio error", case.get("ratio_relative_error"), 0.05),
+            "impact ratio within 5 %")
+
+
+def _approaches_ideal(case: _Case) -> Judged:
+    return (*_bounded("clearance excess", case.get("clearance_excess_relative"), 1.0,
+                      "clearances"), "excess <= one clearance")
+
+
+def _energy_growth(case: _Case) -> Judged:
+    return (*_percent("energy growth", case.get("energy_growth_relative"),
+                      ENERGY_GROWTH_ALLOWANCE),
+            f"energy growth <= {_number(100 * ENERGY_GROWTH_ALLOWANCE)} %")
+
+
+def _energy_conserved(case: _Case) -> Judged:
+    return (*_percent("energy drift", case.get("energy_drift_relative"),
+                      ENERGY_GROWTH_ALLOWANCE),
+            f"energy drift <= {_number(100 * ENERGY_GROWTH_ALLOWANCE)} %")
+
+
+def _no_penetration(case: _Case) -> Judged:
+    bound = 0.01 * smallest_contact_feature(case.scene)
+    return (*_bounded("penetration", case.get("penetration_max"), bound, case.length),
+            f"penetration <= {bound:.3g}")
+
+
+def _output_value(case: _Case) -> Judged:
+    expectation = case.expectation
+    parameters = dict(expectation.parameters)
+    output = next(o for o in case.scene.outputs if o.name == expectation.output)
+    unit = unit_text(case.scene, output.dimension)
+    passed, detail = _bounded(f"{output.name} off by", case.get("deviation"),
+                              case.get("tolerance", math.nan), unit)
+    if case.get("value") is not None:
+        detail += (f": {_number(case.get('value'))} against {_number(case.get('expected'))}"
+                   f"{' ' + unit if unit else ''}")
+    tolerances = []
+    if "absolute_tolerance" in parameters:
+        tolerances.append(f"{_number(parameters['absolute_tolerance'])}"
+                          f"{' ' + unit if unit else ''}")
+    if "relative_tolerance" in parameters:
+        tolerances.append(f"{_number(100 * parameters['relative_tolerance'])} % of the "
+                          "expected value")
+    return passed, detail, f"{output.name} within {' + '.join(tolerances)}"
+
+
+@dataclass(frozen=True)
+class Criterion:
+    """The pass/fail rule of one expectation kind: what passes, in words (the table of the
+    docs and the report), and ``judge(case) -> (passed or None, detail, criterion)``."""
+
+    passes_when: str
+    judge: Callable[[_Case], Judged]
+
+
+_STICKS = Criterion("displacement <= 1e-4 of the body's size", _sticks)
+_ENERGY_GROWTH = Criterion("energy growth <= 1 % of the energy scale", _energy_growth)
+
+#: Expectation kind -> its criterion: the one table of the harness's pass/fail rules.
+CRITERIA: dict[str, Criterion] = {
+    "bounce_apex": Criterion("every resolved apex within 5 % of e^(2k) h0", _bounce_apex),
+    "incline_stick": _STICKS,
+    "sticks": _STICKS,
+    "incline_slide": Criterion("acceleration within 2 % of g (sin - mu cos)", _incline_slide),
+    "sliding_stop": Criterion("stop distance within 2 % of v0^2 / (2 mu g); stopped (speed "
+                              "<= 1e-3 v0) and slides <= 1e-4 of its size after the stop",
+                              _sliding_stop),
+    "rolling_incline": Criterion("distance within 2 % of a t^2 / 2, a = g sin / (1 + "
+                                 "I/(m r^2)); slip speed <= 1 % of the final speed a T",
+                                 _rolling_incline),
+    "rolling_transition": Criterion("final speed within 2 % of 5 v0 / 7", _rolling_transition),
+    "pendulum": Criterion("period within 1 % and energy drift <= 1 % of m g d", _pendulum),
+    "torque_free": Criterion("angular momentum drift <= 1 % of |L0|", _torque_free),
+    "slider_crank": Criterion("slider position within 1 % of the crank length", _slider_crank),
+    "rocking_ratio": Criterion("first-impact ratio within 5 % of 1 - 1.5 sin^2(alpha)",
+                               _rocking_ratio),
+    "approaches_ideal": Criterion("clearance excess <= one radial clearance",
+                                  _approaches_ideal),
+    "energy_non_increasing": _ENERGY_GROWTH,
+    "energy_balance": Criterion("energy growth <= 1 % of the energy scale, on every run whose "
+                                "scene's energy balance is computed (no driver, point force, "
+                                "moment or law load): implied, not listed", _energy_growth),
+    "output_value": Criterion("|y - expected| <= absolute + relative x |expected| tolerance",
+                              _output_value),
+    "energy_conserved": Criterion("energy drift <= 1 % of the energy scale", _energy_conserved),
+    "no_penetration": Criterion("penetration <= 1 % of the smallest contact feature (radius, "
+                                "half-extent or radial clearance)", _no_penetration),
+}
+
+
+def criteria_table() -> str:
+    """:data:`CRITERIA` as a Markdown table (kinds with the same criterion on one row)."""
+    rows: dict[str, list[str]] = {}
+    for kind, criterion in CRITERIA.items():
+        rows.setdefault(criterion.passes_when, []).append(kind)
+    lines = ["| expectation | passes when |", "|---|---|"]
+    lines += [f"| {', '.join(f'`{k}`' for k in kinds)} | {text.replace('|', chr(92) + '|')} |"
+              for text, kinds in rows.items()]
+    return "\n".join(lines)
+
+
 def judgement(scene: Scene, kind: str, body: str | None, figures: dict,
               where: str = "", expectation=None) -> Judgement:
     """Pass/fail, criterion and detail of one expectation result of ``kind`` about ``body``
-    with ``figures`` (:mod:`.expectation_figures`); ``where`` names the place of the judged
-    figure (a contact pair, a body) for the detail; ``expectation`` (the scene's
+    with ``figures`` (:mod:`.expectation_figures`), by its :data:`CRITERIA` rule; ``where``
+    names the place of the judged figure (a contact pair, a body) for the detail;
+    ``expectation`` (the scene's
     :class:`~clearbench.scenarios.expectations.Expectation`, if any) gives its parameters."""
-    get = figures.get
-    length = scene.units.length
-    parameters = dict(expectation.parameters) if expectation is not None else {}
-    if kind == "bounce_apex":
-        passed, detail = _percent("apex error", get("apex_max_relative_error"), 0.05)
-        criterion = "apex within 5 %"
-    elif kind in ("incline_stick", "sticks"):
-        bound = STICK_FRACTION * body_size(scene.body(body))
-        passed, detail = _bounded("displacement", get("displacement"), bound, length)
-        criterion = f"displacement <= {bound:.3g}"
-    elif kind == "incline_slide":
-        passed, detail = _percent("acceleration error", get("acceleration_relative_error"), 0.02)
-        criterion = "acceleration within 2 %"
-    elif kind == "sliding_stop":
-        bound = STICK_FRACTION * body_size(scene.body(body))
-        stop = get("stop_time")
-        parts = [_percent("stop distance error", analytic_error(kind, figures), 0.02)]
-        if stop is None or not math.isfinite(stop):
-            parts.append((False, "never stopped"))
-        else:
-            moved = _bounded(f"slid after the stop at {_number(stop)} {scene.units.time}",
-                             get("slide_after_stop"), bound, length)
-            parts.append(moved)
-        passed, detail = _all(parts)
-        criterion = f"stop distance within 2 %, then sticks (slides <= {bound:.3g})"
-    elif kind == "rolling_transition":
-        passed, detail = _percent("final speed error", get("final_speed_relative_error"), 0.02)
-        criterion = "final speed within 2 %"
-    elif kind == "rolling_incline":
-        speed = get("expected_final_speed")
-        bound = ROLLING_SLIP_FRACTION * speed if speed is not None else math.nan
-        passed, detail = _all([
-            _percent("distance error", get("distance_relative_error"), 0.02),
-            _bounded("slip speed", get("slip_speed_max"), bound,
-                     f"{length}/{scene.units.time}")])
-        criterion = (f"distance within 2 % of a t^2 / 2, slip <= "
-                     f"{_number(100 * ROLLING_SLIP_FRACTION)} % of the final speed")
-    elif kind == "pendulum":
-        passed, detail = _all([_percent("period error", get("period_relative_error"), 0.01),
-                               _percent("energy drift", get("energy_drift"), 0.01)])
-        criterion = "period within 1 %, energy drift <= 1 %"
-    elif kind == "torque_free":
-        passed, detail = _percent("momentum drift", get("angular_momentum_drift"), 0.01)
-        criterion = "momentum drift <= 1 %"
-    elif kind == "slider_crank":
-        passed, detail = _percent("slider error", get("slider_position_relative_error"), 0.01)
-        criterion = "slider position within 1 % of the crank"
-    elif kind == "rocking_ratio":
-        passed, detail = _percent("impact ratio error", get("ratio_relative_error"), 0.05)
-        criterion = "impact ratio within 5 %"
-    elif kind == "approaches_ideal":
-        passed, detail = _bounded("clearance excess", get("clearance_excess_relative"), 1.0,
-                                  "clearances")
-        criterion = "excess <= one clearance"
-    elif kind in ("energy_non_increasing", "energy_balance"):
-        passed, detail = _percent("energy growth", get("energy_growth_relative"),
-                                  ENERGY_GROWTH_ALLOWANCE)
-        criterion = f"energy growth <= {_number(100 * ENERGY_GROWTH_ALLOWANCE)} %"
-    elif kind == "energy_conserved":
-        passed, detail = _percent("energy drift", get("energy_drift_relative"),
-                                  ENERGY_GROWTH_ALLOWANCE)
-        criterion = f"energy drift <= {_number(100 * ENERGY_GROWTH_ALLOWANCE)} %"
-    elif kind == "no_penetration":
-        bound = 0.01 * smallest_contact_feature(scene)
-        passed, detail = _bounded("penetration", get("penetration_max"), bound, length)
-        criterion = f"penetration <= {bound:.3g}"
-    elif kind == "output_value":
-        output = next(o for o in scene.outputs if o.name == expectation.output)
-        unit = unit_text(scene, output.dimension)
-        passed, detail = _bounded(f"{output.name} off by", get("deviation"),
-                                  get("tolerance", math.nan), unit)
-        if get("value") is not None:
-            detail += (f": {_number(get('value'))} against {_number(get('expected'))}"
-                       f"{' ' + unit if unit else ''}")
-        tolerances = []
-        if "absolute_tolerance" in parameters:
-            tolerances.append(f"{_number(parameters['absolute_tolerance'])}"
-                              f"{' ' + unit if unit else ''}")
-        if "relative_tolerance" in parameters:
-            tolerances.append(f"{_number(100 * parameters['relative_tolerance'])} % of the "
-                              "expected value")
-        criterion = f"{output.name} within {' + '.join(tolerances)}"
-    else:
+    criterion = CRITERIA.get(kind)
+    if criterion is None:
         return Judgement(None, "no criterion", "no criterion")
+    passed, detail, words = criterion.judge(_Case(scene, body, figures, expectation))
     if where and passed is not None:
         detail += f" ({where})"
-    return Judgement(passed, criterion, detail)
+    return Judgement(passed, words, detail)
 
 
 @dataclass(frozen=True)

@@ -233,11 +233,14 @@ class Runner:
             # fill idle slots
             while queue and (len(self._slots) < self.jobs
                              or any(s.job is None for s in self._slots)):
+                job = self._next_ready(queue)
+                if job is None:
+                    break
                 idle = next((s for s in self._slots if s.job is None), None)
                 if idle is None:
                     idle = self._start_worker()
                     self._slots.append(idle)
-                self._dispatch(idle, queue.popleft())
+                self._dispatch(idle, job)
             busy = [s for s in self._slots if s.job is not None]
             now = time.monotonic()
             wait_for = max(0.0, min(s.deadline for s in busy) - now)
@@ -253,6 +256,21 @@ class Runner:
                         bar.update(1)
                         bar.set_postfix_str(f"{finished.spec.label}: {record.status}",
                                             refresh=False)
+
+    def _next_ready(self, queue: deque) -> RunJob | None:
+        """Take out of ``queue`` the first job that may start: one whose reference run (the
+        trajectory its error is measured against) is not still queued or running in this
+        batch; None when every queued job waits for one that is running. So one batch may
+        hold fine references and the runs measured against them, in any order of workers."""
+        if queue[0].reference_key is None:
+            return queue.popleft()
+        running = [s.job.spec.key for s in self._slots if s.job is not None]
+        waiting = {job.spec.key for job in queue}.union(running)
+        for index, job in enumerate(queue):
+            if job.reference_key is None or job.reference_key not in waiting:
+                del queue[index]
+                return job
+        return None if running else queue.popleft()
 
     def _service(self, slot: _Slot):
         """Advance ``slot``; return a _Finished when its run is complete."""

@@ -45,11 +45,14 @@ def _case(request: dict) -> dict:
         "status": trajectory.status.value,
         "stepping_seconds": float(trajectory.stepping_seconds),
         "steps": int(trajectory.steps),
-        "unconverged_steps": len(metadata.get("unconverged_steps", [])),
+        # Revisions before the typed statistics kept them in the metadata.
+        "unconverged_steps": (len(metadata["unconverged_steps"]) if "unconverged_steps" in metadata
+                              else int(trajectory.unconverged_count)),
         "unconverged_projections": len(metadata.get("unconverged_projections", [])),
         "mean_iterations": float(np.mean(trajectory.solver_iterations[1:])),
         "mean_active_contacts": float(np.mean(trajectory.active_contacts[1:])),
-        "solver_seconds": float(metadata.get("solver_seconds", float("nan"))),
+        "solver_seconds": float(metadata.get("solver_seconds",
+                                             getattr(trajectory, "solver_seconds", float("nan")))),
         "contact_sweeps": int(metadata.get("contact_sweeps", 0)),
     }
 

@@ -101,8 +101,9 @@ def record_every(time_step: float) -> int:
 def plan_runs(plan: C60Plan, engines: Sequence[EngineChoice],
               campaign: str = "c60-compare") -> list[RunSpec]:
     """The plan's runs for the engines given (EngineChoice of each available label); labels
-    of the plan whose engine is not among them are left out. The reference runs come first:
-    they are the fine runs the others are measured against."""
+    of the plan whose engine is not among them are left out. The runs of largest expected cost
+    come first (steps x the engine's ``HARNESS_DEFAULTS.c60_step_cost``): on parallel workers
+    the plan then takes about its longest run's wall time, not that run's after all others."""
     chosen = {engine.label: engine for engine in engines}
     specs = []
     for scene_name, ladder in plan.ladders.items():
@@ -115,8 +116,16 @@ def plan_runs(plan: C60Plan, engines: Sequence[EngineChoice],
                     scene_name, label, scene_parameters={"horizon": plan.horizons[scene_name]},
                     time_step=dt, record_every=record_every(dt), timeout=plan.timeout,
                     engine_choice=engine, campaign=f"{campaign}:{plan.name}"))
-    specs.sort(key=lambda s: s.engine.name != "reference")
+    specs.sort(key=lambda s: -expected_cost(s))
     return specs
+
+
+def expected_cost(spec: RunSpec) -> float:
+    """Steps of ``spec`` times its engine's declared C-60 cost per step relative to the
+    reference's (dimensionless: reference steps)."""
+    steps = spec.horizon / spec.time_step
+    declared = engine_defaults(spec.engine.name, {spec.engine.name: spec.engine.module})
+    return steps * declared.c60_step_cost
 
 
 def plan_engines(plan: C60Plan, labels: Sequence[str] | None = None,

@@ -121,12 +121,12 @@ def plan_sweep(scenes: Sequence[str | Scene], engines: Sequence[EngineChoice],
     return plan
 
 
-def execute_plan(plan: SweepPlan, runner: Runner, rerun: bool = False) -> SweepOutcome:
-    """Run the fine references, then the sweep (each skipping runs already stored)."""
-    first = runner.run_all(list(plan.references.values()), rerun=rerun)
-    second = runner.run_all(plan.runs, rerun=rerun)
-    return SweepOutcome(first.ran + second.ran, first.skipped + second.skipped,
-                        first.records + second.records)
+def execute_plan(plan: SweepPlan, runner: Runner, rerun: bool = False,
+                 before: Sequence[RunSpec] = ()) -> SweepOutcome:
+    """Run ``before`` (runs of their own, started first: the longest of a batch), the fine
+    references and the sweep in one batch, skipping runs already stored; a run measured
+    against a fine reference starts once that reference is stored (:class:`Runner`)."""
+    return runner.run_all([*before, *plan.references.values(), *plan.runs], rerun=rerun)
 
 
 def pareto_front(times: np.ndarray, errors: np.ndarray) -> np.ndarray:

@@ -84,7 +84,6 @@ from typing import Any
 
 import numpy as np
 
-from clearbench.kernels.quaternion import quat_from_axis_angle, quat_from_matrix, quat_to_matrix
 from clearbench.scenarios.bodies import Body, Motion
 from clearbench.scenarios.c60 import primitives as prim
 from clearbench.scenarios.c60.variants import ModelParameters, contact_friction
@@ -142,6 +141,14 @@ def prototype_clearances() -> dict[str, float]:
 # ------------------------------------------------------------------------------------------------
 
 
+def _quaternions():
+    """:mod:`clearbench.kernels.quaternion`, imported at the first build: it imports numba
+    (about a second), which registering and listing the C-60 scenes do not need."""
+    from clearbench.kernels import quaternion
+
+    return quaternion
+
+
 @dataclass(frozen=True)
 class Pose:
     """World pose of a body frame: position (3,) [mm], unit quaternion (4,) (w, x, y, z)."""
@@ -151,7 +158,7 @@ class Pose:
 
     @property
     def rotation(self) -> np.ndarray:
-        return quat_to_matrix(self.quaternion)
+        return _quaternions().quat_to_matrix(self.quaternion)
 
     def point(self, local) -> np.ndarray:
         return self.position + self.rotation @ np.asarray(local, dtype=float)
@@ -162,7 +169,7 @@ class Pose:
 
 def on_pose(body: Mapping[str, Any]) -> Pose:
     """The data sheet's initial (ON) pose of a body entry."""
-    quaternion = quat_from_axis_angle(np.asarray(body["rotation_axis"], dtype=float),
+    quaternion = _quaternions().quat_from_axis_angle(np.asarray(body["rotation_axis"], dtype=float),
                                       float(body["rotation_angle"]))
     return Pose(np.asarray(body["origin"], dtype=float), quaternion)
 
@@ -183,7 +190,7 @@ def _frame_quaternion(x_axis, z_axis) -> tuple[float, float, float, float]:
     x = x - (x @ z) * z
     x = x / np.linalg.norm(x)
     matrix = np.column_stack((x, np.cross(z, x), z))
-    return tuple(float(c) for c in quat_from_matrix(matrix))  # type: ignore[return-value]
+    return tuple(float(c) for c in _quaternions().quat_from_matrix(matrix))  # type: ignore[return-value]
 
 
 # ------------------------------------------------------------------------------------------------

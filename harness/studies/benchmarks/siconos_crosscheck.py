@@ -97,7 +97,7 @@ def _crosscheck_row(scene, preset, ours, theirs) -> CrossCheckRow:
     common = dict(scene=scene.name, preset=preset, time_step=ours.time_step, steps=ours.steps,
                   status=theirs.status.value,
                   reference_residual=float(np.nanmax(ours.solver_residual, initial=0.0)),
-                  reference_unconverged=len(ours.metadata.get("unconverged_steps", []))
+                  reference_unconverged=ours.unconverged_count
                   + len(ours.metadata.get("unconverged_projections", [])),
                   reference_us_per_step=1e6 * ours.stepping_seconds / max(ours.steps, 1),
                   message=theirs.message)
@@ -136,7 +136,7 @@ def _crosscheck_row(scene, preset, ours, theirs) -> CrossCheckRow:
         rotation_difference=float(np.max(rotation)) if len(moving) else 0.0,
         divergence_time=divergence,
         siconos_residual=float(np.nanmax(theirs.solver_residual, initial=0.0)),
-        siconos_unconverged=int(theirs.metadata.get("unconverged_count", 0)),
+        siconos_unconverged=theirs.unconverged_count,
         siconos_us_per_step=1e6 * theirs.stepping_seconds / max(theirs.steps, 1),
         siconos_python_seconds=float(theirs.metadata.get("python_relation_seconds", 0.0)),
         siconos_stepping_seconds=theirs.stepping_seconds)

@@ -59,7 +59,7 @@ def reference_step_costs(repeat: int = 3) -> list[StepCost]:
                 scene=name, steps=trajectory.steps,
                 mean_active_contacts=float(np.mean(trajectory.active_contacts[1:])),
                 stepping_seconds=trajectory.stepping_seconds,
-                solver_seconds=trajectory.metadata["solver_seconds"],
+                solver_seconds=trajectory.solver_seconds,
                 contact_iterations=trajectory.metadata["contact_sweeps"],
             )
             if best is None or cost.stepping_seconds < best.stepping_seconds:
@@ -104,12 +104,12 @@ def c60_costs(presets: tuple[str, ...] = ("default", "newton"),
             out.append(C60Cost(
                 scene=name, preset=preset, steps=trajectory.steps,
                 stepping_seconds=trajectory.stepping_seconds,
-                solver_seconds=trajectory.metadata["solver_seconds"],
+                solver_seconds=trajectory.solver_seconds,
                 mean_active_contacts=float(np.mean(trajectory.active_contacts[1:])),
                 mean_iterations=float(np.mean(trajectory.solver_iterations[1:])),
                 median_residual=float(np.nanmedian(residual)),
                 max_residual=float(np.nanmax(residual)),
-                unconverged_steps=len(trajectory.metadata["unconverged_steps"]),
+                unconverged_steps=trajectory.unconverged_count,
             ))
     return out
 
@@ -152,6 +152,6 @@ def _newton_first_run(horizon: float, newton_first: bool) -> NewtonFirstRun:
         stepper.MoreauJeanStepper._solve = original
     iterations = trajectory.solver_iterations[1:]
     return NewtonFirstRun(newton_first, trajectory.stepping_seconds,
-                          trajectory.metadata["solver_seconds"], float(iterations.mean()),
+                          trajectory.solver_seconds, float(iterations.mean()),
                           float(np.percentile(iterations, 90)),
-                          len(trajectory.metadata["unconverged_steps"]))
+                          trajectory.unconverged_count)

@@ -24,6 +24,7 @@ from clearbench.harness.run.engine_choice import (
     engine_names,
     parse_engine_label,
 )
+from clearbench.harness.run.numba_cache import WARM_UP_TIMEOUT, fill_cache
 from clearbench.harness.run.runner import Runner
 from clearbench.harness.run.spec import RunSpec, make_run_spec, resolve_scene
 from clearbench.harness.run.store import ResultsStore
@@ -190,11 +191,6 @@ def _result_of(row: dict) -> dict:
             "worker_seconds": float(row.get("worker_seconds") or 0.0)}
 
 
-#: Wall-clock limit of a warm-up run [s]: it may compile every numba kernel of the reference
-#: solver and of the measuring code from an empty cache (minutes on a loaded 2-core machine).
-WARM_UP_TIMEOUT = 3600.0
-
-
 def warm_up_specs(entries: Mapping[str, dict],
                   extra_modules: Mapping[str, str] | None = None) -> list[RunSpec]:
     """One run of two steps per distinct scene of the entries of the engines that compile
@@ -219,12 +215,7 @@ def warm_up_specs(entries: Mapping[str, dict],
 def warm_up(entries: Mapping[str, dict], extra_modules: Mapping[str, str] | None = None,
             environment: Mapping[str, str] | None = None) -> None:
     """Run :func:`warm_up_specs` one after the other in one worker (results discarded)."""
-    specs = warm_up_specs(entries, extra_modules)
-    if not specs:
-        return
-    with tempfile.TemporaryDirectory(prefix="clearbench-warm-") as scratch:
-        Runner(ResultsStore(scratch), jobs=1, runs_per_worker=len(specs),
-               environment=environment).run_all(specs, rerun=True)
+    fill_cache(warm_up_specs(entries, extra_modules), jobs=1, environment=environment)
 
 
 def run_suite(specs: Mapping[str, RunSpec], store_dir: str | Path | None = None,
