@@ -17,13 +17,13 @@ from clearbench.adapters.base import RunSettings
 from clearbench.adapters.options import OptionError
 from clearbench.adapters.trajectory import RunStatus
 from clearbench.harness.measure.figures import measure
-from clearbench.scenarios.bodies import Body
+from clearbench.scenarios.bodies import Body, Motion
 from clearbench.scenarios.contacts import ContactPair
-from clearbench.scenarios.inertia import diagonal
-from clearbench.scenarios.joints import RevoluteJoint
+from clearbench.scenarios.inertia import diagonal, solid_sphere
+from clearbench.scenarios.joints import PrismaticJoint, RevoluteJoint
 from clearbench.scenarios.library import get_scene
 from clearbench.scenarios.scene import Scene
-from clearbench.scenarios.shapes import Box, Sphere
+from clearbench.scenarios.shapes import Box, Plane, Sphere
 
 if not engine_availability("drake").available:
     pytest.skip("drake is not installed here", allow_module_level=True)
@@ -178,3 +178,43 @@ def test_restitution_is_mapped_only_where_the_preset_says_so():
     assert abs(tuned["apex_heights.apex_1_relative_error"]) < 0.2
     assert default["apex_heights.apex_1_relative_error"] < -0.5
     assert np.isfinite(tuned["energy_growth"])
+
+
+def _ball_on_light_ball(light: float, heavy: float, radius: float = 0.01) -> Scene:
+    """A ball of ``heavy`` kg resting on one of ``light`` kg on the floor, both on vertical
+    prismatic joints (radius 1 cm, touching at rest)."""
+    def ball(name, mass, height):
+        return Body(name, mass=mass, inertia=solid_sphere(mass, radius),
+                    position=(0.0, 0.0, height), shapes=(Sphere("s", radius=radius),))
+
+    ground = Body("ground", motion=Motion.FIXED, shapes=(Plane("floor"),))
+    return Scene(name="stack", horizon=0.5, time_step=1e-3,
+                 bodies=(ground, ball("low", light, radius), ball("top", heavy, 3 * radius)),
+                 joints=tuple(PrismaticJoint(f"slide_{b}", body_a="ground", body_b=b,
+                                             axis=(0.0, 0.0, 1.0)) for b in ("low", "top")),
+                 contacts=(ContactPair("floor_low", body_a="ground", shape_a="floor",
+                                       body_b="low", shape_b="s"),
+                           ContactPair("low_top", body_a="low", shape_a="s", body_b="top",
+                                       shape_b="s")))
+
+
+@pytest.mark.parametrize(("light", "threshold", "softened"),
+                         [(10.0, 1.0, False), (1e-3, 1.0, True), (1e-3, 0.0, False)])
+def test_sap_softens_the_contacts_of_a_light_body_under_a_heavy_one(light, threshold, softened):
+    # SAP's near-rigid regime (threshold beta, Drake's default 1) bounds a contact's stiffness
+    # by the effective mass of the pair: a 1 g ball under a 10 kg one (mass ratio 1e4) sinks
+    # 445 times deeper than its stiffness says (measured: 4.36 mm against F/k = 9.81 um at
+    # k = 1e7 N/m); equal masses, or the regime switched off (beta 0), rest at F/k.
+    # At rest a linear point contact sits at F/k exactly: 5 % covers the solver's
+    # tolerance; 100 times is far below the measured softening and far above any error.
+    scene = _ball_on_light_ball(light, 10.0)
+    trajectory, _ = _run(scene, point_stiffness=1e7, sap_near_rigid_threshold=threshold,
+                         hydroelastic_boxes=False)
+    assert trajectory.status is RunStatus.OK, trajectory.message
+    z = trajectory.positions[-1, :, 2]
+    depth = (z[1] + 0.01) - (z[2] - 0.01)          # between the two balls [m]
+    expected = 10.0 * 9.81 / 1e7                   # the top ball's weight over k [m]
+    if softened:
+        assert depth > 100 * expected
+    else:
+        assert depth == pytest.approx(expected, rel=0.05)
