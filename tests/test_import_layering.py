@@ -26,7 +26,7 @@ SCENE_CONTENT = ("clearbench.scenarios.library", "clearbench.scenarios.analytic"
 #: Shared modules of the adapters package; every other child of it is one engine's subpackage.
 ADAPTER_SHARED = frozenset({"base", "trajectory", "recording", "joint_tree", "force_elements",
                             "energy_guard", "options", "harness_defaults",
-                            "primitive_pieces"})
+                            "primitive_pieces", "step_monitor"})
 
 
 def _module_files() -> dict[str, Path]:
