@@ -11,7 +11,9 @@ import pytest
 
 from clearbench.harness.c60 import analysis, identification
 from clearbench.harness.c60.identification import Candidate, Identification, VariantFigures
+from clearbench.harness.c60.runs import StudyRuns
 from clearbench.harness.cli.main import main
+from clearbench.harness.run.store import ResultsStore
 from clearbench.scenarios.c60 import model, variants
 
 PAPER = model.load_model()["paper"]
@@ -67,10 +69,10 @@ def test_the_table_has_the_paper_row_then_one_row_per_variant():
     assert "`latch-0.1` (friction C4 0.1)" in lines[4] and "yes / yes / yes" in lines[4]
 
 
-def test_cached_only_runs_nothing_and_lists_what_is_missing(tmp_path):
-    study = identification.identify(tmp_path, candidates=identification.candidates(
-        "latch-0.1"), cached_only=True)
-    assert study.runs == {}
+def test_stored_only_runs_nothing_and_lists_what_is_missing(tmp_path):
+    runs = StudyRuns(ResultsStore(tmp_path / "store"), run_missing=False)
+    study = identification.identify(runs, candidates=identification.candidates("latch-0.1"))
+    assert study.runs == {} and runs.made == [] and len(runs.store) == 0
     assert study.missing == ["identify_on_mean_latch-0.1", "identify_on_prototype_latch-0.1",
                              "identify_trip_test_latch-0.1"]
     assert math.isnan(study.figures[0].fc1_prototype)
@@ -79,9 +81,10 @@ def test_cached_only_runs_nothing_and_lists_what_is_missing(tmp_path):
 
 
 def test_an_unknown_variant_is_refused_before_any_run(tmp_path, capsys):
-    assert main(["c60", "identify", "--variants", "source,paper", "--cache",
+    assert main(["c60", "identify", "--variants", "source,paper", "--store",
                  str(tmp_path)]) == 2
     assert "paper" in capsys.readouterr().err
+    assert not (tmp_path / "runs.sqlite").exists()
 
 
 def test_pin_and_lamage_are_closer_on_the_bar_than_the_papers_means_allow():

@@ -258,28 +258,3 @@ def test_report_has_the_c60_section_when_the_validation_json_exists(small_store,
     # Without the file the section is left out.
     plain = write_report(small_store, tmp_path / "plain", c60_validation=tmp_path / "none.json")
     assert "C-60: the reference" not in plain["html"].read_text()
-
-
-def test_c60_validation_cache_is_keyed_on_the_physics_code(tmp_path, monkeypatch):
-    # A cached run is reused only by the same scene, preset and physics code: after a solver
-    # change the validation reruns instead of reporting the old solver's figures.
-    import clearbench
-    from clearbench.harness.c60 import runs as c60_runs
-
-    first = c60_runs.run_scene("ball", "bouncing-ball-e0", {}, tmp_path)
-    assert first.trajectory.metadata["physics_code"] == clearbench.source_digest(
-        c60_runs.PHYSICS_CODE)
-    calls = []
-    real_create = c60_runs.create
-
-    def counting_create(preset):
-        calls.append(preset)
-        return real_create(preset)
-
-    monkeypatch.setattr(c60_runs, "create", counting_create)
-    again = c60_runs.run_scene("ball", "bouncing-ball-e0", {}, tmp_path)
-    assert calls == [] and np.array_equal(again.trajectory.positions,
-                                          first.trajectory.positions)
-    monkeypatch.setitem(clearbench._SOURCE_DIGESTS, c60_runs.PHYSICS_CODE, "0" * 16)
-    c60_runs.run_scene("ball", "bouncing-ball-e0", {}, tmp_path)
-    assert calls == ["default"]

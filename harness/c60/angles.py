@@ -1,6 +1,6 @@
 """Each body's absolute angle about z and the largest body speed along a C-60 trajectory
-(``clearbench c60 angles``): a diagnostic of a run, for example one cached by
-``clearbench c60 validate`` (``.cache/c60/contact_force_test.npz``).
+(``clearbench c60 angles``): a diagnostic of a run, for example one that
+``clearbench c60 validate`` kept in the results store (``reports/store/trajectories/KEY.npz``).
 
 The angle is the one the source's angle laws use, in (-pi, pi]: a body turning through the cut
 (pi) shows as a jump here, while the laws keep it continuous.

@@ -13,23 +13,23 @@ combinations (:data:`clearbench.scenarios.c60.variants.VARIANTS`) with the refer
   the probe in C7's place); the contact-force test's loaded travel (2.0 mm measured).
 * Section 5.3: the trip test's peak force, its position and the trip distance.
 
-Each run is cached (:func:`clearbench.harness.c60.runs.run_scene`: the trajectory file is
-reused when its scene, which records the variant, the preset and the physics code are this
-run's), so a rerun only steps what changed. Runs are short where the figure allows: c60-on for
-:data:`ON_HORIZON` (the mechanism has settled by 3 ms, FCs are averaged over the last 1 ms and
-their drift over that millisecond is reported).
+Each run is made through the one run pipeline and kept in the results store
+(:class:`clearbench.harness.c60.runs.StudyRuns`: keyed by its scene, which records the
+variant, the preset and the code), so a rerun only steps what changed. Runs are short where the
+figure allows: c60-on for :data:`ON_HORIZON` (the mechanism has settled by 3 ms, FCs are
+averaged over the last 1 ms and their drift over that millisecond is reported).
 """
 
 from __future__ import annotations
 
 import json
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from clearbench.harness.c60 import analysis
-from clearbench.harness.c60.runs import Run, run_scene
+from clearbench.harness.c60.runs import Run, RunRequest, StudyRuns
 from clearbench.scenarios.c60 import model
 from clearbench.scenarios.c60.variants import model_parameters
 
@@ -120,7 +120,7 @@ class VariantFigures:
 class Identification:
     figures: list[VariantFigures] = field(default_factory=list)
     runs: dict[str, Run] = field(default_factory=dict)
-    missing: list[str] = field(default_factory=list)   # keys not in the cache (cached_only)
+    missing: list[str] = field(default_factory=list)   # runs not in the store (stored only)
 
 
 def _paper() -> dict:
@@ -151,60 +151,84 @@ def _bar_tilt(run: Run) -> float:
                run.trajectory.orientations[times >= times[-1] - 1.0, index])
 
 
-def identify(cache: Path | None, preset: str = "default",
-             candidates: Sequence[Candidate] = CANDIDATES, on_horizon: float = ON_HORIZON,
-             progress: Callable[[str], None] | None = None,
-             cached_only: bool = False, calibrate: bool = True) -> Identification:
-    """Run (or read from ``cache``) every candidate's runs and collect the figures; with
-    ``cached_only`` only what the cache holds (the rest stays NaN, listed in
-    ``Identification.missing``). With ``calibrate``, then the labelled calibration
-    (:func:`calibration`) when the candidates include its bracket."""
-    study = Identification()
-    mean_clearances = {joint: MEAN_CLEARANCE for joint in model.JOINTS}
-    prototype = model.prototype_clearances()
+def candidate_runs(candidate: Candidate, on_horizon: float = ON_HORIZON
+                   ) -> dict[str, RunRequest]:
+    """The runs of one candidate, in the order the study reads them (those it asks for):
+    ``mean`` and ``prototype``, c60-on for ``on_horizon`` [ms] with every joint at
+    :data:`MEAN_CLEARANCE` and with the prototype's clearances; ``trip``, the trip test;
+    ``contact``, the contact-force test."""
+    requests = {}
+    if candidate.on:
+        mean_clearances = {joint: MEAN_CLEARANCE for joint in model.JOINTS}
+        for key, clearances in (("mean", mean_clearances),
+                                ("prototype", model.prototype_clearances())):
+            requests[key] = RunRequest(
+                f"identify_on_{key}_{candidate.name}", "c60-on",
+                {**candidate.parameters, "clearances": clearances, "horizon": on_horizon})
+    if candidate.trip_test:
+        requests["trip"] = RunRequest(f"identify_trip_test_{candidate.name}",
+                                      "c60-trip-force-test", candidate.parameters, 20)
+    if candidate.contact_test:
+        requests["contact"] = RunRequest(f"identify_contact_test_{candidate.name}",
+                                         "c60-contact-force-test", candidate.parameters, 20)
+    return requests
 
-    def run(key: str, name: str, parameters: dict, record_every: int = 10) -> Run | None:
-        if progress:
-            progress(key)
-        done = run_scene(key, name, parameters, cache, preset, record_every,
-                         run_missing=not cached_only)
+
+def study_runs(candidates: Sequence[Candidate], on_horizon: float = ON_HORIZON
+               ) -> list[RunRequest]:
+    """Every run of ``candidates`` (:func:`candidate_runs`; the calibration's, which depends
+    on their figures, not included)."""
+    return [request for candidate in candidates
+            for request in candidate_runs(candidate, on_horizon).values()]
+
+
+def identify(runs: StudyRuns, candidates: Sequence[Candidate] = CANDIDATES,
+             on_horizon: float = ON_HORIZON, calibrate: bool = True) -> Identification:
+    """Make (or read from the store of ``runs``) every candidate's runs and collect the
+    figures; with ``runs.run_missing`` False only what the store holds (the rest stays NaN,
+    listed in ``Identification.missing``). With ``calibrate``, then the labelled calibration
+    (:func:`calibration`) when the candidates include its bracket. A run that did not end ok
+    is noted with its status on its variant; a run that left no trajectory gives no figures."""
+    study = Identification()
+
+    def run(request: RunRequest) -> Run | None:
+        done = runs.get(request)
         if done is None:
-            study.missing.append(key)
+            study.missing.append(request.name)
         else:
-            study.runs[key] = done
+            study.runs[request.name] = done
         return done
 
     def measure(batch: Sequence[Candidate]) -> None:
+        runs.make(study_runs(batch, on_horizon))
         batch_figures = []
         for candidate in batch:
-            variant = candidate.name
             figures = VariantFigures(candidate, model_parameters(**candidate.parameters).label())
             study.figures.append(figures)
             batch_figures.append(figures)
+            requests = candidate_runs(candidate, on_horizon)
             if candidate.on:
-                on = run(f"identify_on_mean_{variant}", "c60-on",
-                         {**candidate.parameters, "clearances": mean_clearances,
-                          "horizon": on_horizon})
-                if on is not None:
+                on = run(requests["mean"])
+                if on is not None and on.usable:
                     figures.fc_mean, figures.fc_drift = _fc_values(on)
                     figures.bar_tilt = _bar_tilt(on)
                     figures.opened = _opened(figures.fc_mean["FC-1"])
-                proto = run(f"identify_on_prototype_{variant}", "c60-on",
-                            {**candidate.parameters, "clearances": prototype,
-                             "horizon": on_horizon})
-                if proto is not None:
+                proto = run(requests["prototype"])
+                if proto is not None and proto.usable:
                     figures.fc1_prototype = _fc_values(proto)[0]["FC-1"]
                     figures.opened_prototype = _opened(figures.fc1_prototype)
                 for key, done in (("mean", on), ("prototype", proto)):
-                    if done is not None and done.trajectory.status.value != "ok":
-                        figures.notes.append(f"c60-on ({key} clearances) ended "
-                                             f"{done.trajectory.status.value}")
+                    if done is not None and not done.ok:
+                        figures.notes.append(f"c60-on ({key} clearances) {done.ended}")
         for figures in batch_figures:
             candidate = figures.candidate
             if candidate.trip_test:
-                trip = run(f"identify_trip_test_{candidate.name}", "c60-trip-force-test",
-                           candidate.parameters, record_every=20)
+                trip = run(candidate_runs(candidate, on_horizon)["trip"])
                 if trip is None:
+                    continue
+                if not trip.ok:
+                    figures.notes.append(f"trip test {trip.ended}")
+                if not trip.usable:
                     continue
                 curve = analysis.trip_force_curve(trip.scene, trip.trajectory)
                 if curve.displacement.size == 0:
@@ -219,17 +243,15 @@ def identify(cache: Path | None, preset: str = "default",
         for figures in batch_figures:
             candidate = figures.candidate
             if candidate.contact_test:
-                test = run(f"identify_contact_test_{candidate.name}", "c60-contact-force-test",
-                           candidate.parameters, record_every=20)
+                test = run(candidate_runs(candidate, on_horizon)["contact"])
                 if test is None:
                     continue
-                if test.trajectory.status.value == "ok":
+                if test.ok:
                     curve = analysis.contact_force_curve(test.scene, test.trajectory)
                     figures.contact_force = curve.equilibrium_force
                     figures.contact_travel = curve.loaded_travel
                 else:
-                    figures.notes.append(f"contact-force test ended "
-                                         f"{test.trajectory.status.value}")
+                    figures.notes.append(f"contact-force test {test.ended}")
 
     measure(candidates)
     if calibrate:
@@ -489,14 +511,15 @@ def write_markdown(study: Identification, path: Path, preset: str, on_horizon: f
     if notes:
         lines += ["## Notes on runs", "", *notes, ""]
     if study.missing:
-        lines += ["## Runs not made", "", "Not in the cache when this table was written "
-                  "(`--cached-only`); their cells are '-': " + ", ".join(study.missing) + ".",
+        lines += ["## Runs not made", "", "Not in the results store when this table was "
+                  "written (`--stored-only`); their cells are '-': "
+                  + ", ".join(study.missing) + ".",
                   ""]
     lines += ["## Runs", "", "| run | scene | status | steps | stepping [s] | unconverged "
               "steps |", "|---|---|---|---|---|---|"]
     for key, run in study.runs.items():
-        lines.append(f"| {key} | {run.scene.name} | {run.trajectory.status.value} | "
-                     f"{run.trajectory.steps} | {run.trajectory.stepping_seconds:.0f} | "
+        lines.append(f"| {key} | {run.scene.name} | {run.status} | "
+                     f"{run.steps} | {run.stepping_seconds:.0f} | "
                      f"{len(run.unconverged)} |")
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text("\n".join(lines) + "\n")

@@ -1,9 +1,10 @@
 """The C-60 validation table: our runs against the published figures (Akhadkar, Acary,
 Brogliato 2018, Sections 4.2 and 5), with the differences reported, never tuned away.
 
-:func:`validate` runs the scenes it needs with the reference engine (each run cached as a
-trajectory file keyed by the scene's content hash), computes the figures and returns a
-:class:`ValidationReport`; :func:`write_markdown` and :func:`write_figures` render it.
+:func:`validate` runs the scenes it needs with the reference engine through the one run
+pipeline (:class:`~clearbench.harness.c60.runs.StudyRuns`: isolated workers, a wall-clock limit,
+the results store), computes the figures and returns a :class:`ValidationReport`;
+:func:`write_markdown` and :func:`write_figures` render it.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ import dataclasses
 import json
 import logging
 import math
+from collections import defaultdict
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -19,11 +21,12 @@ import numpy as np
 
 from clearbench.harness.c60 import analysis, identification
 from clearbench.harness.c60.identification import ON_HORIZON
-from clearbench.harness.c60.runs import PHYSICS_CODE, Run, run_scene  # noqa: F401 (re-exported)
+from clearbench.harness.c60.runs import Run, RunRequest, StudyRuns
 from clearbench.harness.measure import series as metrics
 from clearbench.kernels.quaternion import quat_to_matrix
 from clearbench.ref_solver.forces import twist_angle
 from clearbench.scenarios.c60 import model
+from clearbench.scenarios.library import get_scene
 from clearbench.scenarios.scene import Scene
 
 logger = logging.getLogger(__name__)
@@ -75,7 +78,7 @@ def _paper() -> dict:
 
 #: Variants of the identification study whose figures the validation shows beside the
 #: source's model and uses for the measured causes of its differences (runs shared with
-#: ``clearbench c60 identify`` through the cache).
+#: ``clearbench c60 identify`` through the results store).
 SENSITIVITY_VARIANTS = (
     dataclasses.replace(identification.candidates("source")[0], trip_test=False,
                         contact_test=False),
@@ -119,24 +122,63 @@ def _variant_rows(study: identification.Identification, report: ValidationReport
                                    distance["measured"], note=note))
 
 
-def validate(cache: Path | None = None, preset: str = "default", speed_check: bool = True,
+#: The runs of the table, by their name in the report: (scene, factory parameters, one
+#: recorded sample every that many steps). Bench scenes with the prototype's clearances.
+BASE_RUNS = {
+    "on_nominal": ("c60-on", {}, 10),
+    "on_prototype": ("c60-on", {"clearances": "prototype"}, 10),
+    "trip": ("c60-trip", {}, 10),
+    "contact_force_test": ("c60-contact-force-test", {}, 20),
+    "trip_force_test": ("c60-trip-force-test", {}, 20),
+}
+
+
+def _request(name: str) -> RunRequest:
+    scene, parameters, record_every = BASE_RUNS[name]
+    if parameters.get("clearances") == "prototype":
+        parameters = {**parameters, "clearances": model.prototype_clearances()}
+    return RunRequest(name, scene, parameters, record_every)
+
+
+def _half_speed(name: str, scene_name: str) -> RunRequest:
+    """The bench test ``scene_name`` at half its probe's speed (the speed check)."""
+    speed = _probe_speed(get_scene(scene_name))
+    return RunRequest(name, scene_name, {"probe_speed": 0.5 * speed}, 40)
+
+
+def validation_runs(speed_check: bool = True, sensitivity: bool = True) -> list[RunRequest]:
+    """Every run the table may need, in one batch (:meth:`StudyRuns.make`): the C-60 scenes,
+    the variants' runs with ``sensitivity``, the half-speed bench tests with ``speed_check``
+    (the contact-force test's is used only when the test at full speed gives a curve)."""
+    requests = [_request(name) for name in BASE_RUNS]
+    if sensitivity:
+        requests += identification.study_runs(SENSITIVITY_VARIANTS)
+    if speed_check:
+        requests += [_half_speed("trip_force_test_half_speed", "c60-trip-force-test"),
+                     _half_speed("contact_force_test_half_speed", "c60-contact-force-test")]
+    return requests
+
+
+def validate(runs: StudyRuns, speed_check: bool = True,
              sensitivity: bool = True) -> ValidationReport:
-    """Run what the table needs and fill it (see the module docstring)."""
+    """Make (or read from the store of ``runs``) what the table needs and fill it (see the
+    module docstring). A run that did not end ok is a finding with its status and message; a
+    run that left no trajectory gives no figures (its rows read NaN)."""
     report = ValidationReport()
     paper = _paper()
     experiments = paper["experiments"]
     fcs = paper["functional_conditions"]
-    prototype = model.prototype_clearances()
+    runs.make(validation_runs(speed_check, sensitivity))
 
-    def run(key, name, parameters, record_every=10):
-        report.runs[key] = run_scene(key, name, parameters, cache, preset, record_every)
-        return report.runs[key]
+    def run(request: RunRequest) -> Run:
+        report.runs[request.name] = runs.get(request)
+        return report.runs[request.name]
 
     # Equilibrium in the ON pose: nominal (the sheet's) and prototype clearances.
-    nominal = run("on_nominal", "c60-on", {})
-    settled = analysis.settled_outputs(nominal.scene, nominal.trajectory)
-    on_proto = run("on_prototype", "c60-on", {"clearances": prototype})
-    settled_proto = analysis.settled_outputs(on_proto.scene, on_proto.trajectory)
+    nominal = run(_request("on_nominal"))
+    settled = _settled(nominal)
+    on_proto = run(_request("on_prototype"))
+    settled_proto = _settled(on_proto)
     force = experiments["contact_force_at_equilibrium_N"]
     report.rows.append(Row(
         "FC-1, C7 force at equilibrium, prototype clearances (c60-on)", "N",
@@ -153,21 +195,26 @@ def validate(cache: Path | None = None, preset: str = "default", speed_check: bo
                                settled[output], fcs[key]["mean"],
                                note=f"sigma {fcs[key]['sigma']} mm; {description}"))
     # The magnetic trip.
-    trip = run("trip", "c60-trip", {})
-    events = analysis.trip_events(trip.scene, trip.trajectory)
-    report.curves["trip_events"] = events
+    trip = run(_request("trip"))
+    if trip.usable:
+        events = analysis.trip_events(trip.scene, trip.trajectory)
+        report.curves["trip_events"] = events
+        chatter = (f"{events.chatter} C7 re-closures between release and opening; smallest C7 "
+                   f"gap in the 1 ms after: {events.gap_after:.3f} mm")
+    else:
+        events = analysis.TripEvents(math.nan, math.nan, math.nan, 0, math.nan)
+        chatter = f"the run {trip.ended}"
     report.rows.append(Row("c60-trip: plunger strikes the tripping bar", "ms", events.strike,
                            note="no published figure"))
     report.rows.append(Row("c60-trip: latch released (C4, C5 unloaded)", "ms", events.release,
                            note="no published figure"))
     report.rows.append(Row("c60-trip: contacts open (C7 gap > 0.1 mm)", "ms",
-                           events.opening, note=f"no published figure; {events.chatter} C7 "
-                           f"re-closures between release and opening; smallest C7 gap in the "
-                           f"1 ms after: {events.gap_after:.3f} mm"))
-    report.findings.append(_trip_failure(trip))
+                           events.opening, note=f"no published figure; {chatter}"))
+    if trip.usable:
+        report.findings.append(_trip_failure(trip))
 
     # Bench: contact force vs displacement (prototype clearances).
-    contact = run("contact_force_test", "c60-contact-force-test", {}, record_every=20)
+    contact = run(_request("contact_force_test"))
     contact_ok = _bench_run_usable(contact, report)
     if contact_ok:
         curve = analysis.contact_force_curve(contact.scene, contact.trajectory)
@@ -179,34 +226,61 @@ def validate(cache: Path | None = None, preset: str = "default", speed_check: bo
                                curve.loaded_travel,
                                paper_measured=experiments["contact_test_total_displacement_mm"]))
     # Bench: tripping force vs displacement (prototype clearances).
-    trip_test = run("trip_force_test", "c60-trip-force-test", {}, record_every=20)
-    trip_curve = analysis.trip_force_curve(trip_test.scene, trip_test.trajectory)
-    report.curves["trip_force"] = {"v": trip_curve}
+    trip_test = run(_request("trip_force_test"))
     peak = experiments["trip_test_peak_force_N"]
     distance = experiments["trip_test_total_distance_mm"]
-    report.rows.append(Row("Trip test: peak force", "N", trip_curve.peak_force,
+    trip_curve = None
+    if trip_test.usable:
+        trip_curve = analysis.trip_force_curve(trip_test.scene, trip_test.trajectory)
+        report.curves["trip_force"] = {"v": trip_curve}
+    figures = (trip_curve.peak_force, trip_curve.peak_displacement, trip_curve.trip_distance) \
+        if trip_curve is not None else (math.nan,) * 3
+    report.rows.append(Row("Trip test: peak force", "N", figures[0],
                            peak["simulated"], peak["measured"]))
-    report.rows.append(Row("Trip test: displacement at the peak", "mm",
-                           trip_curve.peak_displacement,
+    report.rows.append(Row("Trip test: displacement at the peak", "mm", figures[1],
                            paper_measured=experiments["trip_test_peak_at_mm"]))
-    report.rows.append(Row("Trip test: total trip distance", "mm", trip_curve.trip_distance,
+    report.rows.append(Row("Trip test: total trip distance", "mm", figures[2],
                            distance["simulated"], distance["measured"]))
-    report.findings.append(_first_contact_phase(trip_test))
+    if trip_test.usable:
+        report.findings.append(_first_contact_phase(trip_test))
     sheet_fc6 = settled[model.FUNCTIONAL_CONDITIONS["FC-6"][0]]
     if sensitivity:
-        study = identification.identify(cache, preset, SENSITIVITY_VARIANTS, calibrate=False)
+        study = identification.identify(runs, SENSITIVITY_VARIANTS, calibrate=False)
         report.runs.update(study.runs)
         _variant_rows(study, report)
         report.causes = measured_causes(study, sheet_fc6)
     else:
         report.causes = default_causes(sheet_fc6)
-    report.findings.append(explain_contact_force(nominal))
+    if nominal.usable:
+        report.findings.append(explain_contact_force(nominal))
     if speed_check:
+        _speed_check(report, run, trip_test, trip_curve, contact,
+                     curve if contact_ok else None)
+    for key, done in report.runs.items():
+        if not done.ok:
+            report.findings.append(f"Run {key} ({done.scene.name}) ended "
+                                   f"{done.status}: {done.message}")
+        if done.penetration > PENETRATION_LIMIT:
+            report.findings.append(
+                f"Run {key} ({done.scene.name}): a contact penetrates {done.penetration:.3g} mm, "
+                f"beyond the issue's {PENETRATION_LIMIT:g} mm "
+                f"({len(done.unconverged_projections)} steps "
+                "whose projection did not reach its tolerance).")
+    return report
+
+
+def _speed_check(report: ValidationReport, run, trip_test: Run, trip_curve, contact: Run,
+                 contact_curve) -> None:
+    """The bench tests again at half their probe's speed (``run(request)`` makes a run): a
+    finding each on whether the curve is the same (``trip_curve``, ``contact_curve``: the
+    curves at full speed, None when that run gave none, and then no rerun)."""
+    slow_curve = slow_contact = None
+    if trip_curve is not None:
+        slow_curve = _half_speed_curve(run(_half_speed("trip_force_test_half_speed",
+                                                       "c60-trip-force-test")),
+                                       analysis.trip_force_curve, report.curves["trip_force"])
+    if slow_curve is not None:
         base_speed = _probe_speed(trip_test.scene)
-        slow = run("trip_force_test_half_speed", "c60-trip-force-test",
-                   {"probe_speed": 0.5 * base_speed}, record_every=40)
-        slow_curve = analysis.trip_force_curve(slow.scene, slow.trajectory)
-        report.curves["trip_force"]["v/2"] = slow_curve
         same = _same_curve(trip_curve.peak_force, slow_curve.peak_force,
                            trip_curve.trip_distance, slow_curve.trip_distance)
         report.findings.append(
@@ -217,12 +291,14 @@ def validate(cache: Path | None = None, preset: str = "default", speed_check: bo
             + ("the same curve within" if same else "NOT the same curve within")
             + f" the stated tolerance ({100 * SPEED_FORCE_TOLERANCE:.0f} % of the peak force, "
             f"{SPEED_DISTANCE_TOLERANCE} mm of trip distance).")
-    if speed_check and contact_ok:
+    if contact_curve is not None:
+        slow_contact = _half_speed_curve(run(_half_speed("contact_force_test_half_speed",
+                                                         "c60-contact-force-test")),
+                                         analysis.contact_force_curve,
+                                         report.curves["contact_force"])
+    if slow_contact is not None:
         contact_speed = _probe_speed(contact.scene)
-        slow = run("contact_force_test_half_speed", "c60-contact-force-test",
-                   {"probe_speed": 0.5 * contact_speed}, record_every=40)
-        slow_contact = analysis.contact_force_curve(slow.scene, slow.trajectory)
-        report.curves["contact_force"]["v/2"] = slow_contact
+        curve = contact_curve
         same = _same_curve(curve.equilibrium_force, slow_contact.equilibrium_force,
                            curve.loaded_travel, slow_contact.loaded_travel)
         report.findings.append(
@@ -232,17 +308,23 @@ def validate(cache: Path | None = None, preset: str = "default", speed_check: bo
             f"{slow_contact.loaded_travel:.4f} mm: "
             + ("the same curve within" if same else "NOT the same curve within")
             + " the stated tolerance.")
-    for key, done in report.runs.items():
-        if done.trajectory.status.value != "ok":
-            report.findings.append(f"Run {key} ({done.scene.name}) ended "
-                                   f"{done.trajectory.status.value}: {done.trajectory.message}")
-        if done.penetration > PENETRATION_LIMIT:
-            report.findings.append(
-                f"Run {key} ({done.scene.name}): a contact penetrates {done.penetration:.3g} mm, "
-                f"beyond the issue's {PENETRATION_LIMIT:g} mm "
-                f"({len(done.trajectory.metadata.get('unconverged_projections', []))} steps "
-                "whose projection did not reach its tolerance).")
-    return report
+
+
+def _half_speed_curve(slow: Run, curve_of, curves: dict):
+    """The bench curve of the half-speed run ``slow`` (``curve_of(scene, trajectory)``), kept
+    in ``curves`` as ``v/2``; None when the run left no trajectory (its status is a finding)."""
+    if not slow.usable:
+        return None
+    curves["v/2"] = curve_of(slow.scene, slow.trajectory)
+    return curves["v/2"]
+
+
+def _settled(run: Run) -> dict:
+    """Every output of ``run`` over its last millisecond (NaN for each when the run left no
+    trajectory)."""
+    if run.usable:
+        return analysis.settled_outputs(run.scene, run.trajectory)
+    return defaultdict(lambda: math.nan)
 
 
 def _same_curve(force: float, slow_force: float, distance: float, slow_distance: float) -> bool:
@@ -258,16 +340,20 @@ def _bench_run_usable(run: Run, report: ValidationReport) -> bool:
     gives no curve and why (probe never loaded, when the mechanism's fastest body first
     exceeded 10 mm/ms). A run that did not end ok is also reported with its status and message
     by :func:`validate`, once for every run."""
+    if not run.usable:
+        report.findings.append(f"{run.key} ({run.scene.name}): no curve (status {run.status}, "
+                               "no trajectory).")
+        return False
     values = metrics.output_values(run.scene, run.trajectory)
     loaded = bool(np.any(values["probe_force"] > analysis.FORCE_THRESHOLD))
-    if run.trajectory.status.value == "ok" and loaded:
+    if run.ok and loaded:
         return True
     speeds = np.abs(run.trajectory.velocities).max(axis=2).max(axis=1)
     fast = np.nonzero(speeds > 10.0)[0]
     onset = (f"; the mechanism's fastest body exceeds 10 mm/ms from t = "
              f"{run.trajectory.times[fast[0]]:.2f} ms" if fast.size else "")
     report.findings.append(
-        f"{run.key} ({run.scene.name}): no curve (status {run.trajectory.status.value}"
+        f"{run.key} ({run.scene.name}): no curve (status {run.status}"
         f"{', probe never loaded' if not loaded else ''}{onset}).")
     return False
 
@@ -361,7 +447,8 @@ MODEL_NOTES = (
     "does, but continuous: a body turning through the cut of the raw angle (pi) keeps its law "
     "continuous (the source's would jump by k 2 pi; in the ON and trip runs no law body comes "
     "near the cut). `clearbench c60 angles TRAJECTORY.npz` prints each body's raw "
-    "angle and the largest body speed along a run (the runs are cached in .cache/c60/).",
+    "angle and the largest body speed along a run (each run's trajectory is in the results "
+    "store, `trajectories/KEY.npz`, KEY the run's `store_key` in reports/c60_validation.json).",
     "Bounded faces: TRIP_1 and C3 ON 1, 2 have their nearest point beyond the face (no "
     "contact candidate; OpenCASCADE measures to the face's edge, 0.86 and 3.8 mm in the ON "
     "pose). Every other ON-pose gap agrees with OpenCASCADE within the CAD's B-spline residual "
@@ -496,9 +583,9 @@ def write_markdown(report: ValidationReport, path: Path, figures: dict[str, Path
         unconverged = run.unconverged
         listed = ", ".join(str(k) for k in unconverged[:5]) + (" ..." if len(unconverged) > 5
                                                               else "")
-        lines.append(f"| {key} | {run.scene.name} | {run.trajectory.status.value} | "
-                     f"{run.trajectory.steps} | "
-                     f"{run.trajectory.stepping_seconds:.0f} | {len(unconverged)}"
+        lines.append(f"| {key} | {run.scene.name} | {run.status} | "
+                     f"{run.steps} | "
+                     f"{run.stepping_seconds:.0f} | {len(unconverged)}"
                      f"{' (' + listed + ')' if unconverged else ''} | {run.penetration:.2e} |")
     if figures:
         lines += ["", "## Figures", ""]
@@ -534,13 +621,12 @@ def write_json(report: ValidationReport, path: Path, figures: dict[str, Path],
                   if abs(_number(row.difference()) or 0.0) > EXPLAIN_ABOVE else None}
                  for row in report.rows],
         "findings": list(report.findings),
-        "runs": [{"key": key, "scene": run.scene.name, "steps": run.trajectory.steps,
-                  "stepping_seconds": run.trajectory.stepping_seconds,
-                  "status": run.trajectory.status.value, "message": run.trajectory.message,
+        "runs": [{"key": key, "scene": run.scene.name, "steps": run.steps,
+                  "stepping_seconds": _number(run.stepping_seconds),
+                  "status": run.status, "message": run.message,
                   "unconverged_steps": len(run.unconverged),
-                  "unconverged_projections": len(
-                      run.trajectory.metadata.get("unconverged_projections", [])),
-                  "max_penetration_mm": run.penetration}
+                  "unconverged_projections": len(run.unconverged_projections),
+                  "max_penetration_mm": _number(run.penetration), "store_key": run.store_key}
                  for key, run in report.runs.items()],
         "figures": {title: Path(figure).resolve().relative_to(base).as_posix()
                     if Path(figure).resolve().is_relative_to(base) else str(figure)
@@ -609,7 +695,7 @@ def write_figures(report: ValidationReport, directory: Path) -> dict[str, Path]:
 def _trip_failure(run: Run) -> str:
     """What did not converge in the run and the largest penetration, where and when."""
     trajectory = run.trajectory
-    projections = list(trajectory.metadata.get("unconverged_projections", []))
+    projections = run.unconverged_projections
     depth = metrics.penetration(run.scene, trajectory)
     text = (f"c60-trip: {len(run.unconverged)} of {trajectory.steps} steps whose contact "
             f"problem did not converge {run.unconverged[:5]}, {len(projections)} whose "

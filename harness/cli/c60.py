@@ -1,16 +1,17 @@
 """``clearbench c60``: the C-60 circuit-breaker tools.
 
 - ``clearbench c60 validate``: the validation table against the published figures. Runs the
-  C-60 scenes it needs with the reference engine (cached per scene content in ``--cache``),
-  prints the table and writes it as Markdown with force-displacement figures.
+  C-60 scenes it needs with the reference engine (isolated workers, a wall-clock limit, runs
+  kept in the results store ``--store``), prints the table and writes it as Markdown with
+  force-displacement figures.
 - ``clearbench c60 compare [--plan demo|full]``: c60-on and c60-trip in every available engine
   and preset over a ladder of steps (the plans of :mod:`clearbench.harness.studies.c60_comparison`),
   the cross-engine table and the work-precision summary printed, then the report written.
 - ``clearbench c60 identify``: the identification study (which of the source's documented
   alternatives reproduces which section of the paper), one table in
-  ``reports/c60_identification.md``.
+  ``reports/c60_identification.md``; its runs go through the store like the validation's.
 - ``clearbench c60 angles TRAJECTORY.npz``: each body's angle about z and the largest body
-  speed along a run (a diagnostic, for example of a cached run).
+  speed along a run (a diagnostic, for example of a stored run).
 """
 
 from __future__ import annotations
@@ -20,11 +21,12 @@ import math
 from dataclasses import replace
 from pathlib import Path
 
-from clearbench.adapters.reference import ReferenceEngine
 from clearbench.adapters.trajectory import Trajectory
 from clearbench.harness.c60 import identification
 from clearbench.harness.c60.angles import body_angles
 from clearbench.harness.c60.cross_engine import collect
+from clearbench.harness.c60.runs import DEFAULT_TIMEOUT as STUDY_TIMEOUT
+from clearbench.harness.c60.runs import StudyRuns
 from clearbench.harness.c60.validation import validate, write_figures, write_json, write_markdown
 from clearbench.harness.c60.work_precision import steps_for_target, work_precision
 from clearbench.harness.cli.commands import command_help
@@ -38,12 +40,11 @@ from clearbench.harness.cli.common import (
 )
 from clearbench.harness.measure.headline import format_value
 from clearbench.harness.report.page import write_report
-from clearbench.harness.run.engine_choice import RunInputError
+from clearbench.harness.run.engine_choice import RunInputError, resolve_engine
 from clearbench.harness.studies.c60_comparison import PLAN_NAMES, c60_plan, plan_engines, plan_runs
 
 DEFAULT_REPORT = Path("reports/c60_validation.md")
 DEFAULT_FIGURES = Path("reports/figures")
-DEFAULT_CACHE = Path(".cache/c60")
 DEFAULT_IDENTIFICATION = Path("reports/c60_identification.md")
 
 
@@ -59,10 +60,12 @@ def register(subparsers) -> None:
     commands.required = True
     validate = commands.add_parser(
         "validate", help="run the C-60 scenes and write the validation table",
-        description="Run (or read from the cache) the C-60 scenes, print the validation "
-        "table, write it as Markdown and the force-displacement figures as PNG. A full run "
-        "takes tens of minutes of stepping on one core; cached runs are reused when the "
-        "scene, the preset and the physics code (scenes, solver, adapters) are unchanged.",
+        description="Run (or read from the results store) the C-60 scenes, print the "
+        "validation table, write it as Markdown and the force-displacement figures as PNG. "
+        "Each run executes in its own worker process with a wall-clock limit and is kept in "
+        "the store under its run key (scene, preset, settings, code), so a repeated command "
+        "reuses it; a run that crashed, timed out or diverged is reported as such. The first "
+        "time tens of minutes of stepping on one core.",
     )
     _add_run_options(validate, DEFAULT_REPORT, "Markdown report")
     validate.add_argument("--figures", type=Path, default=DEFAULT_FIGURES,
@@ -93,28 +96,29 @@ def register(subparsers) -> None:
     compare.set_defaults(handler=run_c60_compare)
     identify = commands.add_parser(
         "identify", help="which documented variant of the model reproduces which paper figure",
-        description="Run (or read from the cache) c60-on at the paper's mean clearances and "
-        "at the prototype's, and the bench tests, for the source's documented alternatives "
-        "and their combinations; write one table of every published figure per variant with "
-        "the sections each matches. About 30 c60-on runs of 4 ms and 6 bench tests: tens of "
-        "minutes on one core the first time, seconds from the cache.",
+        description="Run (or read from the results store) c60-on at the paper's mean "
+        "clearances and at the prototype's, and the bench tests, for the source's documented "
+        "alternatives and their combinations; write one table of every published figure per "
+        "variant with the sections each matches. About 30 c60-on runs of 4 ms and 8 bench "
+        "tests: tens of minutes on one core the first time, seconds from the store.",
     )
     _add_run_options(identify, DEFAULT_IDENTIFICATION, "Markdown table (JSON beside it)")
     identify.add_argument("--variants", metavar="NAME,...",
                           help="only these variants of the study (default: all of them)")
     identify.add_argument("--runs", choices=("all", "on", "bench"), default="all",
-                          help="all (default), only the c60-on runs, or only the bench tests "
-                          "(two processes can share the cache without running a case twice)")
+                          help="all (default), only the c60-on runs, or only the bench tests")
     identify.add_argument("--no-calibration", action="store_true",
                           help="skip the labelled calibration (the preload fitted to the "
                           "prototype's FC-1, judged on the other figures)")
-    identify.add_argument("--cached-only", action="store_true",
-                          help="write the table from the cached runs only, running nothing")
+    identify.add_argument("--stored-only", action="store_true",
+                          help="write the table from the runs in the store only, running "
+                          "nothing")
     identify.set_defaults(handler=run_identify)
     angles = commands.add_parser(
         "angles", help="each body's angle about z and the largest speed along a trajectory",
-        description="For a trajectory written by the reference engine (for example the cache "
-        "of `clearbench c60 validate`: .cache/c60/contact_force_test.npz), print every EVERY "
+        description="For a trajectory written by the reference engine (for example a run of "
+        "`clearbench c60 validate` in the store: reports/store/trajectories/KEY.npz, KEY the "
+        "run's store_key in reports/c60_validation.json), print every EVERY "
         "ms the absolute angle of each body about z (the angle the source's angle laws use, "
         "in (-pi, pi]) and the largest body speed. A diagnostic; asserts nothing.",
     )
@@ -125,25 +129,32 @@ def register(subparsers) -> None:
 
 
 def _add_run_options(parser, report: Path, what: str) -> None:
-    """--out, --cache and --preset of the commands that run the C-60 scenes."""
+    """--out, --preset and the runner's options of the commands that run the C-60 studies."""
     parser.add_argument("--out", type=Path, default=report, help=f"{what} (default {report})")
-    parser.add_argument("--cache", type=Path, default=DEFAULT_CACHE,
-                        help=f"directory of cached trajectories (default {DEFAULT_CACHE})")
     parser.add_argument("--preset", default="default", help="reference engine preset")
+    add_runner_options(parser, timeout=STUDY_TIMEOUT, engine_module=False)
 
 
-def _check_preset(preset: str) -> None:
-    try:
-        ReferenceEngine(preset)   # the engine's own preset check, before any run
-    except ValueError as error:
-        raise UserError(str(error)) from None
+def _study_runs(args: argparse.Namespace, campaign: str, run_missing: bool = True) -> StudyRuns:
+    """The runs of a study in the command's store, made by the command's runner with the
+    reference engine's ``--preset`` (checked before any run: exit 2)."""
+    engine = resolve_engine(f"reference[{args.preset}]")
+    store = open_store(args)
+    runner = make_runner(args, store, total=2)   # a study makes several runs
+    return StudyRuns(store, runner, engine, timeout=args.timeout, run_missing=run_missing,
+                     rerun=args.rerun, campaign=campaign)
+
+
+def _print_made(runs: StudyRuns) -> None:
+    print(f"C-60 runs: {len(runs.made)} made, {len(runs.reused)} reused from the store "
+          f"({runs.store.directory})")
 
 
 def run_validate(args: argparse.Namespace) -> int:
-    _check_preset(args.preset)
-    report = validate(cache=args.cache, preset=args.preset,
-                      speed_check=not args.no_speed_check,
+    runs = _study_runs(args, "c60-validate")
+    report = validate(runs, speed_check=not args.no_speed_check,
                       sensitivity=not args.no_sensitivity)
+    _print_made(runs)
     print(f"{'quantity':<78} {'ours':>9} {'sim.':>7} {'meas.':>7} {'diff':>8}")
     for row in report.rows:
         difference = row.difference()
@@ -153,8 +164,8 @@ def run_validate(args: argparse.Namespace) -> int:
     for finding in report.findings:
         print(f"- {finding}")
     figures = write_figures(report, args.figures)
-    write_markdown(report, args.out, figures, args.preset)
-    write_json(report, args.out.with_suffix(".json"), figures, args.preset)
+    write_markdown(report, args.out, figures, runs.preset)
+    write_json(report, args.out.with_suffix(".json"), figures, runs.preset)
     print(f"report: {args.out} (and {args.out.with_suffix('.json')} for `clearbench report`)")
     for path in figures.values():
         print(f"figure: {path}")
@@ -162,7 +173,6 @@ def run_validate(args: argparse.Namespace) -> int:
 
 
 def run_identify(args: argparse.Namespace) -> int:
-    _check_preset(args.preset)
     candidates = identification.CANDIDATES
     if args.variants:
         wanted = [name.strip() for name in args.variants.split(",") if name.strip()]
@@ -176,13 +186,12 @@ def run_identify(args: argparse.Namespace) -> int:
         candidates = tuple(replace(c, trip_test=False, contact_test=False) for c in candidates)
     elif args.runs == "bench":
         candidates = tuple(replace(c, on=False) for c in candidates)
-    study = identification.identify(args.cache, args.preset, candidates,
-                                    progress=lambda key: print(f"run {key}", flush=True),
-                                    cached_only=args.cached_only,
-                                    calibrate=not args.no_calibration)
+    runs = _study_runs(args, "c60-identify", run_missing=not args.stored_only)
+    study = identification.identify(runs, candidates, calibrate=not args.no_calibration)
+    _print_made(runs)
     lines = identification.table_lines(study)
     print("\n".join(lines))
-    identification.write_markdown(study, args.out, args.preset, identification.ON_HORIZON)
+    identification.write_markdown(study, args.out, runs.preset, identification.ON_HORIZON)
     identification.write_json(study, args.out.with_suffix(".json"))
     print(f"report: {args.out} (and {args.out.with_suffix('.json')})")
     return 0

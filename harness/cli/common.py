@@ -38,8 +38,10 @@ def add_store_option(parser: argparse.ArgumentParser) -> None:
                         f"{DEFAULT_STORE})")
 
 
-def add_runner_options(parser: argparse.ArgumentParser, timeout: float = DEFAULT_TIMEOUT) -> None:
-    """--store, --jobs, --timeout, --runs-per-worker, --rerun, --engine-module, --no-progress."""
+def add_runner_options(parser: argparse.ArgumentParser, timeout: float = DEFAULT_TIMEOUT,
+                       engine_module: bool = True) -> None:
+    """--store, --jobs, --timeout, --runs-per-worker, --rerun, --engine-module (unless not
+    ``engine_module``: a command that runs only the reference engine), --no-progress."""
     add_store_option(parser)
     parser.add_argument("--jobs", "-j", type=int, default=None,
                         help=f"parallel worker processes (default: usable cores, here "
@@ -51,7 +53,8 @@ def add_runner_options(parser: argparse.ArgumentParser, timeout: float = DEFAULT
                         "fresh process per run; a crashed or timed-out worker is always replaced)")
     parser.add_argument("--rerun", action="store_true",
                         help="run again even when the run is already in the store")
-    add_engine_module_option(parser)
+    if engine_module:
+        add_engine_module_option(parser)
     parser.add_argument("--no-progress", action="store_true",
                         help="no progress bar (terminal) nor progress lines (log or pipe)")
 
