@@ -1,5 +1,5 @@
 """The C-60 identification study's bookkeeping (no stepping): which section a variant's figures
-match, the table, the cached-only mode, the command's input checks, and the rigid-body bound
+match, the table, the stored-only mode, the command's input checks, and the rigid-body bound
 on FC-2..FC-5."""
 
 from __future__ import annotations
