@@ -28,8 +28,8 @@ HARNESS_DEFAULTS = HarnessDefaults(
 
 
 def availability() -> tuple[bool, str]:
-    """Whether Debian's interpreter imports Siconos (:func:`.engine.availability`: a probe in
-    that interpreter, cached); never raises."""
-    from clearbench.adapters.siconos.engine import availability as probe
+    """Whether Debian's interpreter imports Siconos (:func:`.process.siconos_availability`:
+    a probe in that interpreter, its answer cached); never raises."""
+    from clearbench.adapters.siconos.process import siconos_availability
 
-    return probe()
+    return siconos_availability()

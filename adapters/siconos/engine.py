@@ -44,9 +44,7 @@ configuration; see :mod:`.worker.geometry`), and any feature the adapter does no
 
 from __future__ import annotations
 
-import functools
 import json
-import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -54,9 +52,7 @@ import numpy as np
 from clearbench.adapters.base import ModuleEngine, RunSettings
 from clearbench.adapters.siconos import HARNESS_DEFAULTS, capabilities
 from clearbench.adapters.siconos.process import (
-    SICONOS_PYTHON,
     WorkerStatus,
-    interpreter_imports,
     run_worker,
 )
 from clearbench.adapters.siconos.settings import (
@@ -70,22 +66,6 @@ from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.serialization import scene_to_json
 
 WORKER_SCRIPT = Path(__file__).parent / "worker" / "engine.py"
-
-@functools.cache
-def availability() -> tuple[bool, str]:
-    """Whether Debian's interpreter imports the Siconos kernel and joints (never raises)."""
-    available, why = interpreter_imports(
-        "siconos.kernel, siconos.mechanics.joints, siconos.numerics")
-    if not available:
-        return False, why
-    try:
-        version = subprocess.run(
-            ["dpkg-query", "-W", "-f=${Version}", "python3-siconos"],
-            capture_output=True, text=True, timeout=30).stdout.strip()
-    except (OSError, subprocess.TimeoutExpired):
-        version = ""
-    return True, f"Debian python3-siconos {version}".strip() + f" under {SICONOS_PYTHON}"
-
 
 def create(preset: str = "default") -> SiconosEngine:
     return SiconosEngine(preset)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import enum
 import functools
+import json
 import os
 import subprocess
 import tempfile
@@ -78,11 +79,63 @@ def interpreter_imports(modules: str) -> tuple[bool, str]:
     return True, ""
 
 
+#: What a run imports in Debian's interpreter.
+SICONOS_MODULES = "siconos.kernel, siconos.mechanics.joints, siconos.numerics"
+#: dpkg's file list of the installed ``python3-siconos``: rewritten by every install, upgrade
+#: or removal of the package, so its size and modification time key the probe's answer.
+DPKG_LIST = Path("/var/lib/dpkg/info/python3-siconos.list")
+
+
+def _install_state() -> str | None:
+    """Size and modification time of :data:`DPKG_LIST` and of the interpreter (None when
+    dpkg did not install the package: then every call probes)."""
+    try:
+        stats = [DPKG_LIST.stat(), Path(SICONOS_PYTHON).stat()]
+    except OSError:
+        return None
+    return ";".join(f"{s.st_size}:{s.st_mtime_ns}" for s in stats)
+
+
+def _probe() -> tuple[bool, str]:
+    available, why = interpreter_imports(SICONOS_MODULES)
+    if not available:
+        return False, why
+    try:
+        version = subprocess.run(
+            ["dpkg-query", "-W", "-f=${Version}", "python3-siconos"],
+            capture_output=True, text=True, timeout=30).stdout.strip()
+    except (OSError, subprocess.TimeoutExpired):
+        version = ""
+    return True, f"Debian python3-siconos {version}".strip() + f" under {SICONOS_PYTHON}"
+
+
 @functools.cache
 def siconos_availability() -> tuple[bool, str]:
-    """(available, message): whether ``import siconos.numerics`` works under SICONOS_PYTHON."""
-    available, why = interpreter_imports("siconos.numerics")
-    return (True, "Siconos available") if available else (False, why)
+    """(available, message): whether Debian's interpreter imports the Siconos kernel, joints
+    and numerics, and the package's version. A probe starts that interpreter and imports
+    Siconos (about a second); a positive answer is kept in the user's cache directory,
+    keyed by the package's install state (:func:`_install_state`), so that listing engines
+    and starting runs do not pay it each time. Never raises."""
+    state = _install_state()
+    path = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "clearbench" \
+        / "siconos-availability.json"
+    if state is not None:
+        try:
+            kept = json.loads(path.read_text())
+            if kept.get("state") == state:
+                return True, str(kept["detail"])
+        except (OSError, ValueError, KeyError):
+            pass
+    available, detail = _probe()
+    if available and state is not None:
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            partial = path.with_suffix(f".{os.getpid()}.tmp")
+            partial.write_text(json.dumps({"state": state, "detail": detail}))
+            partial.replace(path)
+        except OSError:  # an unwritable cache costs the probe next time
+            pass
+    return available, detail
 
 
 def siconos_available() -> bool:
