@@ -31,7 +31,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from clearbench.kernels.jit import njit
 
 __all__ = [
     "FRAME_POLE",

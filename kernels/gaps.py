@@ -2,8 +2,9 @@
 
 The conventions (normal from A toward B, signed gap, contact frame, what each pair returns) are
 documented in :mod:`clearbench.scenarios.geometry`, which is the public entry point; this module
-holds the compiled kernels and the shape codes they dispatch on. Only :func:`pair_contacts` is
-meant to be called from outside.
+holds the compiled kernels and the shape codes they dispatch on. Only :func:`pair_contacts` and
+:func:`pair_contact_slots` (every candidate in a fixed slot, for an engine with one interaction
+per candidate: the Siconos worker) are meant to be called from outside.
 
 Implementation notes. :func:`pair_contacts` converts its inputs to tuples once, so the kernels
 below take tuples and scalars (no array arguments, hence no reference counting in the hot
@@ -18,9 +19,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from clearbench.kernels.frames import frame_tangent
+from clearbench.kernels.jit import njit
 
 # Shape codes (module constants, compiled in as literals).
 SPHERE = 0
@@ -837,28 +838,39 @@ def _ring_cylinder(ring_position, ring_rotation, ring_radius, start_angle, span,
 # ------------------------------------------------------------------------------------------------
 
 
+@njit(cache=True, inline="always")
+def _copy_staged(stage, source, target):
+    """Move the staged contact of slot ``source`` to slot ``target`` (compaction)."""
+    for i in range(3):
+        for j in range(3):
+            stage[target, i, j] = stage[source, i, j]
+
+
+@njit(cache=True, inline="always")
+def _inside_face(plane_position, plane_rotation, half_x, half_y, radius, depth, stage, k):
+    """True if the staged contact ``k`` lies in the face: its point on A (row 1 of the stage)
+    within |x| <= half_x and |y| <= half_y (rectangle, radius < 0) or x^2 + y^2 <= radius^2
+    (disc) in the face's frame, and its gap not below -depth (depth 0: no bound)."""
+    if depth > 0.0 and stage[k, 2, 0] < -depth:
+        return False
+    point = (stage[k, 1, 0], stage[k, 1, 1], stage[k, 1, 2])
+    local = _to_local(plane_position, plane_rotation, point)
+    if radius >= 0.0:
+        return local[0] * local[0] + local[1] * local[1] <= radius * radius
+    return abs(local[0]) <= half_x and abs(local[1]) <= half_y
+
+
 @njit(cache=True)
 def _keep_inside_face(plane_position, plane_rotation, half_x, half_y, radius, depth, count,
                       stage):
-    """Keep the staged contacts whose point on A (row 1 of the stage) lies in the face:
-    |x| <= half_x and |y| <= half_y (rectangle, radius < 0) or x^2 + y^2 <= radius^2 (disc)
-    in the face's frame, and whose gap is not below -depth (depth 0: no bound). Returns the
+    """Keep the staged contacts that lie in the face (:func:`_inside_face`). Returns the
     number kept (compacted to the front, order preserved)."""
     kept = 0
     for k in range(count):
-        if depth > 0.0 and stage[k, 2, 0] < -depth:
-            continue
-        point = (stage[k, 1, 0], stage[k, 1, 1], stage[k, 1, 2])
-        local = _to_local(plane_position, plane_rotation, point)
-        if radius >= 0.0:
-            inside = local[0] * local[0] + local[1] * local[1] <= radius * radius
-        else:
-            inside = abs(local[0]) <= half_x and abs(local[1]) <= half_y
-        if inside:
+        if _inside_face(plane_position, plane_rotation, half_x, half_y, radius, depth, stage,
+                        k):
             if kept != k:
-                for i in range(3):
-                    for j in range(3):
-                        stage[kept, i, j] = stage[k, i, j]
+                _copy_staged(stage, k, kept)
             kept += 1
     return kept
 
@@ -883,8 +895,9 @@ def _ring_in_bore(ring_position, ring_rotation, ring_radius, start_angle, span, 
                   bore_span, check_axial, index, stage):
     """Ring (A) inside the bore (B): gap = bore radius - largest distance of a ring point from
     the bore axis; the normal points from that ring point radially outward (from A into B).
-    The contact is kept only if its point on the bore lies within the bore's angles (and,
-    with ``check_axial``, within |z| <= half_length). Returns 1 if staged at ``index``, else 0.
+    The contact is staged at ``index`` in every case and kept only if its point on the bore
+    lies within the bore's angles (and, with ``check_axial``, within |z| <= half_length).
+    Returns 1 if kept, else 0 (a compacting caller then reuses the slot).
     """
     axis = _column(bore_rotation, 2)
     e1 = _column(ring_rotation, 0)
@@ -902,13 +915,42 @@ def _ring_in_bore(ring_position, ring_rotation, ring_radius, start_angle, span, 
     ring_point = _add(ring_position, _add(_scale(e1, ring_radius * c),
                                           _scale(e2, ring_radius * s)))
     gap = bore_radius - distance
+    _stage(stage, index, gap, ring_point, outward)
     on_bore = _axpy(gap, outward, ring_point)
     if check_axial and abs(_dot(_sub(on_bore, bore_position), axis)) > bore_half_length:
         return 0
     if not _bore_angle_in_range(bore_position, bore_rotation, on_bore, bore_start, bore_span):
         return 0
-    _stage(stage, index, gap, ring_point, outward)
     return 1
+
+
+@njit(cache=True, inline="always")
+def _cylinder_end_in_bore(end, direction, centre, reach, journal_position, journal_rotation,
+                          journal_radius, journal_half_length, bore_position, bore_rotation,
+                          bore_radius, bore_half_length, bore_start, bore_span, index, stage):
+    """The candidate at the ``end`` (-1: the bore's -z side, +1: its +z side) of the axial
+    overlap of a journal (A) and a bore (B), staged at ``index``; True if kept. An end inside
+    the bore is the journal's end rim (ring in the bore, dropped outside the bore's angles); an
+    end where the journal runs beyond the bore is the bore's end rim against the journal's
+    lateral surface (always kept)."""
+    axis_b = _column(bore_rotation, 2)
+    if end * (centre + end * reach) > bore_half_length:
+        # The journal runs beyond this end of the bore: the bore's end rim.
+        rim_position = _axpy(end * bore_half_length, axis_b, bore_position)
+        is_arc = bore_span < _TWO_PI
+        _ring_cylinder(rim_position, bore_rotation, bore_radius, bore_start, bore_span, is_arc,
+                       journal_position, journal_rotation, journal_radius, stage[index:])
+        # Mirror into (A = journal, B = bore): normal from the journal outward.
+        gap = stage[index, 2, 0]
+        normal = (-stage[index, 0, 0], -stage[index, 0, 1], -stage[index, 0, 2])
+        rim_point = (stage[index, 1, 0], stage[index, 1, 1], stage[index, 1, 2])
+        _stage(stage, index, gap, _axpy(-gap, normal, rim_point), normal)
+        return True
+    rim_position = _axpy(direction * end * journal_half_length, _column(journal_rotation, 2),
+                         journal_position)
+    return _ring_in_bore(rim_position, journal_rotation, journal_radius, 0.0, _TWO_PI, False,
+                         bore_position, bore_rotation, bore_radius, bore_half_length,
+                         bore_start, bore_span, False, index, stage) == 1
 
 
 @njit(cache=True)
@@ -917,44 +959,94 @@ def _cylinder_in_bore(journal_position, journal_rotation, journal_radius, journa
                       bore_span, stage):
     """Journal cylinder (A) inside the bore (B): one candidate at each end of their axial
     overlap, where the radial gap of two nearly coaxial cylinders is smallest (it is concave
-    along the axis). An end inside the bore is the journal's end rim (ring in the bore); an end
-    where the journal runs beyond the bore is the bore's end rim against the journal's lateral
-    surface. No overlap: no candidate."""
+    along the axis), in slot 0 (the bore's -z side) and slot 1 (its +z side)
+    (:func:`_cylinder_end_in_bore`). Returns (slots, kept_0, kept_1): no overlap gives no slot
+    (nothing staged)."""
     axis_b = _column(bore_rotation, 2)
     axis_j = _column(journal_rotation, 2)
     direction = 1.0 if _dot(axis_j, axis_b) >= 0.0 else -1.0
     centre = _dot(_sub(journal_position, bore_position), axis_b)
     reach = journal_half_length * abs(_dot(axis_j, axis_b))
     if centre - reach > bore_half_length or centre + reach < -bore_half_length:
-        return 0
-    count = 0
-    for end in (-1.0, 1.0):
-        if end * (centre + end * reach) > bore_half_length:
-            # The journal runs beyond this end of the bore: the bore's end rim.
-            rim_position = _axpy(end * bore_half_length, axis_b, bore_position)
-            is_arc = bore_span < _TWO_PI
-            _ring_cylinder(rim_position, bore_rotation, bore_radius, bore_start, bore_span,
-                           is_arc, journal_position, journal_rotation, journal_radius,
-                           stage[count:])
-            # Mirror into (A = journal, B = bore): normal from the journal outward.
-            gap = stage[count, 2, 0]
-            normal = (-stage[count, 0, 0], -stage[count, 0, 1], -stage[count, 0, 2])
-            rim_point = (stage[count, 1, 0], stage[count, 1, 1], stage[count, 1, 2])
-            _stage(stage, count, gap, _axpy(-gap, normal, rim_point), normal)
-            count += 1
-        else:
-            rim_position = _axpy(direction * end * journal_half_length, axis_j,
-                                 journal_position)
-            count += _ring_in_bore(rim_position, journal_rotation, journal_radius, 0.0,
-                                   _TWO_PI, False, bore_position, bore_rotation, bore_radius,
-                                   bore_half_length, bore_start, bore_span, False, count,
-                                   stage)
-    return count
+        return 0, False, False
+    kept_0 = _cylinder_end_in_bore(-1.0, direction, centre, reach, journal_position,
+                                   journal_rotation, journal_radius, journal_half_length,
+                                   bore_position, bore_rotation, bore_radius, bore_half_length,
+                                   bore_start, bore_span, 0, stage)
+    kept_1 = _cylinder_end_in_bore(1.0, direction, centre, reach, journal_position,
+                                   journal_rotation, journal_radius, journal_half_length,
+                                   bore_position, bore_rotation, bore_radius, bore_half_length,
+                                   bore_start, bore_span, 1, stage)
+    return 2, kept_0, kept_1
+
+
+@njit(cache=True, inline="always")
+def _bore_slots(kind_a, params_a, position_a, rotation_a, params_b, position_b, rotation_b,
+                stage):
+    """A circle, arc or journal (A) inside a bore (B): (slots, kept_0, kept_1), every slot
+    staged (:func:`_ring_in_bore`, :func:`_cylinder_in_bore`); slots -1 for any other A."""
+    bore_span = params_b[3] - params_b[2]
+    if kind_a == CIRCLE:
+        kept = _ring_in_bore(position_a, rotation_a, params_a[0], 0.0, _TWO_PI, False,
+                             position_b, rotation_b, params_b[0], params_b[1], params_b[2],
+                             bore_span, True, 0, stage)
+        return 1, kept == 1, False
+    if kind_a == ARC:
+        kept = _ring_in_bore(position_a, rotation_a, params_a[0], params_a[1],
+                             params_a[2] - params_a[1], True, position_b, rotation_b,
+                             params_b[0], params_b[1], params_b[2], bore_span, True, 0, stage)
+        return 1, kept == 1, False
+    if kind_a == CYLINDER:
+        return _cylinder_in_bore(position_a, rotation_a, params_a[0], params_a[1], position_b,
+                                 rotation_b, params_b[0], params_b[1], params_b[2], bore_span,
+                                 stage)
+    return -1, False, False
+
+
+@njit(cache=True, inline="always")
+def _compact_bore_slots(slots, kept_0, kept_1, stage):
+    """Number of kept contacts of :func:`_bore_slots`, moved to the front (-1 stays -1)."""
+    if slots < 0:
+        return -1
+    if kept_0:
+        return 2 if slots == 2 and kept_1 else 1
+    if slots == 2 and kept_1:
+        _copy_staged(stage, 1, 0)
+        return 1
+    return 0
 
 
 # ------------------------------------------------------------------------------------------------
 # Dispatch
 # ------------------------------------------------------------------------------------------------
+
+
+@njit(cache=True, inline="always")
+def _face_candidates(plane_position, plane_rotation, kind_b, params_b, position_b, rotation_b,
+                     stage):
+    """Candidates of a bounded face's plane (A) against X (B) before the face's bounds apply;
+    -1 for an X no bounded face is paired with."""
+    if kind_b == SPHERE:
+        return _plane_sphere(plane_position, plane_rotation, position_b, params_b[0], stage)
+    if kind_b == CYLINDER:
+        return _plane_cylinder(plane_position, plane_rotation, position_b, rotation_b,
+                               params_b[0], params_b[1], stage)
+    if kind_b == CIRCLE:
+        return _plane_ring(plane_position, plane_rotation, position_b, rotation_b, params_b[0],
+                           0.0, _TWO_PI, False, stage)
+    if kind_b == ARC:
+        return _plane_ring(plane_position, plane_rotation, position_b, rotation_b, params_b[0],
+                           params_b[1], params_b[2] - params_b[1], True, stage)
+    return -1
+
+
+@njit(cache=True, inline="always")
+def _face_bounds(kind, params):
+    """(radius, depth) of a bounded face: a disc's radius, -1 for a rectangle; depth 0: no
+    bound."""
+    radius = params[0] if kind == DISC else -1.0
+    depth = params[1] if kind == DISC else params[2]
+    return radius, depth
 
 
 @njit(cache=True, inline="always")
@@ -981,21 +1073,11 @@ def _canonical_contacts(kind_a, params_a, position_a, rotation_a, kind_b, params
                                params_b[1], params_b[2] - params_b[1], True, stage)
         return -1
     if kind_a == RECTANGLE or kind_a == DISC:
-        radius = params_a[0] if kind_a == DISC else -1.0
-        depth = params_a[1] if kind_a == DISC else params_a[2]
-        if kind_b == SPHERE:
-            count = _plane_sphere(position_a, rotation_a, position_b, params_b[0], stage)
-        elif kind_b == CYLINDER:
-            count = _plane_cylinder(position_a, rotation_a, position_b, rotation_b, params_b[0],
-                                    params_b[1], stage)
-        elif kind_b == CIRCLE:
-            count = _plane_ring(position_a, rotation_a, position_b, rotation_b, params_b[0],
-                                0.0, _TWO_PI, False, stage)
-        elif kind_b == ARC:
-            count = _plane_ring(position_a, rotation_a, position_b, rotation_b, params_b[0],
-                                params_b[1], params_b[2] - params_b[1], True, stage)
-        else:
+        count = _face_candidates(position_a, rotation_a, kind_b, params_b, position_b,
+                                 rotation_b, stage)
+        if count < 0:
             return -1
+        radius, depth = _face_bounds(kind_a, params_a)
         return _keep_inside_face(position_a, rotation_a, params_a[0], params_a[1], radius,
                                  depth, count, stage)
     if kind_b == SPHERE:
@@ -1017,21 +1099,9 @@ def _canonical_contacts(kind_a, params_a, position_a, rotation_a, kind_b, params
         return _capsule_capsule(position_a, rotation_a, params_a[0], params_a[1], position_b,
                                 rotation_b, params_b[0], params_b[1], stage)
     if kind_b == BORE:
-        bore_span = params_b[3] - params_b[2]
-        if kind_a == CIRCLE:
-            return _ring_in_bore(position_a, rotation_a, params_a[0], 0.0, _TWO_PI, False,
-                                 position_b, rotation_b, params_b[0], params_b[1], params_b[2],
-                                 bore_span, True, 0, stage)
-        if kind_a == ARC:
-            return _ring_in_bore(position_a, rotation_a, params_a[0], params_a[1],
-                                 params_a[2] - params_a[1], True, position_b, rotation_b,
-                                 params_b[0], params_b[1], params_b[2], bore_span, True, 0,
-                                 stage)
-        if kind_a == CYLINDER:
-            return _cylinder_in_bore(position_a, rotation_a, params_a[0], params_a[1],
-                                     position_b, rotation_b, params_b[0], params_b[1],
-                                     params_b[2], bore_span, stage)
-        return -1
+        slots, kept_0, kept_1 = _bore_slots(kind_a, params_a, position_a, rotation_a, params_b,
+                                            position_b, rotation_b, stage)
+        return _compact_bore_slots(slots, kept_0, kept_1, stage)
     if kind_b == CYLINDER:
         if kind_a == CIRCLE:
             return _ring_cylinder(position_a, rotation_a, params_a[0], 0.0, _TWO_PI, False,
@@ -1074,23 +1144,21 @@ def _as_tuples(params, position, rotation):
     )
 
 
-@njit(cache=True)
-def _pair_contacts_tuples(kind_a, par_a, pos_a, rot_a, kind_b, par_b, pos_b, rot_b, out_gap,
-                          out_point_a, out_point_b, out_frame):
-    """pair_contacts on tuple inputs (params 8, position 3, rotation 3 rows of 3)."""
+@njit(cache=True, inline="always")
+def _computed_in_swapped_order(kind_a, par_a, pos_a, rot_a, kind_b, par_b, pos_b, rot_b):
+    """True if the pair is computed as (B, A) and mirrored: B's kind comes first in
+    CANONICAL_PAIRS, or, for two shapes of one kind, B precedes A in :func:`_placement_precedes`
+    (so that swapping A and B mirrors the result exactly)."""
     if kind_a == kind_b:
-        swap = _placement_precedes(par_b, pos_b, rot_b, par_a, pos_a, rot_a)
-    else:
-        swap = not _CANONICAL[kind_a, kind_b]
-    # out_point_a / out_point_b serve as work arrays (box clipping) before they are written.
-    if swap:
-        count = _canonical_contacts(kind_b, par_b, pos_b, rot_b, kind_a, par_a, pos_a, rot_a,
-                                    out_frame, out_point_a, out_point_b)
-    else:
-        count = _canonical_contacts(kind_a, par_a, pos_a, rot_a, kind_b, par_b, pos_b, rot_b,
-                                    out_frame, out_point_a, out_point_b)
-    if count < 0:
-        raise ValueError("pair_contacts: unsupported pair of shape kinds (check SUPPORTED)")
+        return _placement_precedes(par_b, pos_b, rot_b, par_a, pos_a, rot_a)
+    return not _CANONICAL[kind_a, kind_b]
+
+
+@njit(cache=True, inline="always")
+def _expand_staged(count, swap, out_gap, out_point_a, out_point_b, out_frame):
+    """Turn the ``count`` contacts staged in ``out_frame`` (row 0: normal, row 1: point on A,
+    row [2, 0]: gap, of the computed order) into gaps, both points and frames, mirrored when
+    the pair was computed as (B, A)."""
     previous_normal = (np.nan, np.nan, np.nan)
     tangent = (0.0, 0.0, 0.0)
     for k in range(count):
@@ -1116,6 +1184,23 @@ def _pair_contacts_tuples(kind_a, par_a, pos_a, rot_a, kind_b, par_b, pos_b, rot
         bitangent = _cross(normal, tangent)
         for i in range(3):
             out_frame[k, 2, i] = bitangent[i]
+
+
+@njit(cache=True)
+def _pair_contacts_tuples(kind_a, par_a, pos_a, rot_a, kind_b, par_b, pos_b, rot_b, out_gap,
+                          out_point_a, out_point_b, out_frame):
+    """pair_contacts on tuple inputs (params 8, position 3, rotation 3 rows of 3)."""
+    swap = _computed_in_swapped_order(kind_a, par_a, pos_a, rot_a, kind_b, par_b, pos_b, rot_b)
+    # out_point_a / out_point_b serve as work arrays (box clipping) before they are written.
+    if swap:
+        count = _canonical_contacts(kind_b, par_b, pos_b, rot_b, kind_a, par_a, pos_a, rot_a,
+                                    out_frame, out_point_a, out_point_b)
+    else:
+        count = _canonical_contacts(kind_a, par_a, pos_a, rot_a, kind_b, par_b, pos_b, rot_b,
+                                    out_frame, out_point_a, out_point_b)
+    if count < 0:
+        raise ValueError("pair_contacts: unsupported pair of shape kinds (check SUPPORTED)")
+    _expand_staged(count, swap, out_gap, out_point_a, out_point_b, out_frame)
     return count
 
 
@@ -1159,6 +1244,92 @@ def pair_contacts(kind_a, params_a, position_a, rotation_a, kind_b, params_b, po
     par_b, pos_b, rot_b = _as_tuples(params_b, position_b, rotation_b)
     return _pair_contacts_tuples(kind_a, par_a, pos_a, rot_a, kind_b, par_b, pos_b, rot_b,
                                  out_gap, out_point_a, out_point_b, out_frame)
+
+
+# ------------------------------------------------------------------------------------------------
+# Every candidate in a fixed slot, dropped or not (an engine with one interaction per candidate)
+# ------------------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def _canonical_slots(kind_a, params_a, position_a, rotation_a, kind_b, params_b, position_b,
+                     rotation_b, stage, work_1, work_2, out_kept):
+    """:func:`_canonical_contacts` without compaction: every candidate of a bounded face or a
+    bore stays in its slot and ``out_kept`` flags the ones the bounds keep. Returns the number
+    of slots (-1 for a pair not in CANONICAL_PAIRS)."""
+    if kind_a == RECTANGLE or kind_a == DISC:
+        slots = _face_candidates(position_a, rotation_a, kind_b, params_b, position_b,
+                                 rotation_b, stage)
+        radius, depth = _face_bounds(kind_a, params_a)
+        for k in range(slots):
+            out_kept[k] = _inside_face(position_a, rotation_a, params_a[0], params_a[1], radius,
+                                       depth, stage, k)
+        return slots
+    if kind_b == BORE:
+        slots, kept_0, kept_1 = _bore_slots(kind_a, params_a, position_a, rotation_a, params_b,
+                                            position_b, rotation_b, stage)
+        if slots == 0:
+            # A journal beside the bore (no axial overlap): two empty slots, each given the
+            # journal's centre, a gap 0 and a normal across the bore axis.
+            normal = _any_perpendicular(_column(rotation_b, 2))
+            for k in range(2):
+                _stage(stage, k, 0.0, position_a, normal)
+            slots = 2
+        out_kept[0] = kept_0
+        if slots == 2:
+            out_kept[1] = kept_1
+        return slots
+    slots = _canonical_contacts(kind_a, params_a, position_a, rotation_a, kind_b, params_b,
+                                position_b, rotation_b, stage, work_1, work_2)
+    for k in range(slots):
+        out_kept[k] = True
+    return slots
+
+
+@njit(cache=True)
+def pair_contact_slots(kind_a, params_a, position_a, rotation_a, kind_b, params_b, position_b,
+                       rotation_b, out_gap, out_point_a, out_point_b, out_frame, out_kept):
+    """:func:`pair_contacts` with every candidate in a fixed slot, dropped or not.
+
+    A bounded face (rectangle, disc) drops the candidates off the face or deeper than its
+    depth, a bore those outside its angles or length; :func:`pair_contacts` compacts the kept
+    ones to the front. Here slot k is always the same candidate of the kernel (an engine with
+    one interaction per candidate follows it from step to step) and ``out_kept[k]`` says
+    whether the bounds keep it; the kept slots, in order, are :func:`pair_contacts`'s output.
+    A dropped slot holds the kernel's candidate before the bound applied; a journal with no
+    axial overlap with its bore fills its two slots with its centre, a gap 0 and a normal
+    across the bore axis. Pairs that drop nothing fill every slot with a kept candidate.
+
+    Parameters
+    ----------
+    kind_a, params_a, position_a, rotation_a, kind_b, params_b, position_b, rotation_b
+        As :func:`pair_contacts`.
+    out_gap, out_point_a, out_point_b, out_frame
+        As :func:`pair_contacts` (K >= MAX_CONTACTS_PER_PAIR rows).
+    out_kept : ndarray (K,) bool
+        True for a slot the bounds keep.
+
+    Returns
+    -------
+    int
+        Number of slots written: fixed for each pair of kinds, except box-box and
+        capsule-capsule, whose count of candidates changes with the configuration.
+    """
+    if not (0 <= kind_a < NUMBER_OF_KINDS and 0 <= kind_b < NUMBER_OF_KINDS):
+        raise ValueError("pair_contact_slots: unknown shape code")
+    par_a, pos_a, rot_a = _as_tuples(params_a, position_a, rotation_a)
+    par_b, pos_b, rot_b = _as_tuples(params_b, position_b, rotation_b)
+    swap = _computed_in_swapped_order(kind_a, par_a, pos_a, rot_a, kind_b, par_b, pos_b, rot_b)
+    if swap:
+        slots = _canonical_slots(kind_b, par_b, pos_b, rot_b, kind_a, par_a, pos_a, rot_a,
+                                 out_frame, out_point_a, out_point_b, out_kept)
+    else:
+        slots = _canonical_slots(kind_a, par_a, pos_a, rot_a, kind_b, par_b, pos_b, rot_b,
+                                 out_frame, out_point_a, out_point_b, out_kept)
+    if slots < 0:
+        raise ValueError("pair_contact_slots: unsupported pair of shape kinds (check SUPPORTED)")
+    _expand_staged(slots, swap, out_gap, out_point_a, out_point_b, out_frame)
+    return slots
 
 
 # ------------------------------------------------------------------------------------------------

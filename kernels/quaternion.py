@@ -30,7 +30,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from clearbench.kernels.jit import njit
 
 __all__ = [
     "EXP_TAYLOR_THRESHOLD",

@@ -31,7 +31,8 @@ a test holds it bitwise equal to these kernels.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from clearbench.kernels.jit import njit
 
 __all__ = [
     "evaluate_profile",

@@ -1,25 +1,30 @@
-"""The Siconos worker's plain-numpy geometry agrees with the shared geometry module.
+"""The Siconos worker's contact geometry is the project's gap kernels, one slot per candidate.
 
-The worker runs under Debian's Python without numba, so it carries its own copy of the
-formulas (adapters/siconos/worker/geometry.py). These tests run in the project's environment
-(no Siconos needed) and compare both on random configurations of every pair the worker supports,
-in both orders.
+The worker (adapters/siconos/worker/geometry.py) keeps only what is Siconos's own: the pairs it
+supports with a fixed number of slots (one Siconos interaction each) and the gap of a dropped
+slot; gaps, points and frames come from :func:`clearbench.kernels.gaps.pair_contact_slots`.
+These tests run in the project's environment (no Siconos needed) on random configurations of
+every supported pair, in both orders: each pair fills exactly its declared number of slots, and
+the kept slots, in order, are the shared geometry's (compacted) candidates. That the kernels give
+the same numbers without numba (the worker's interpreter) is tests/test_kernels_without_numba.py.
 """
 
 from __future__ import annotations
 
+import inspect
 import math
 
 import numpy as np
 import pytest
 
 from clearbench.adapters.siconos.worker import geometry as worker
+from clearbench.kernels import gaps
 from clearbench.kernels.quaternion import quat_normalize, quat_to_matrix
 from clearbench.scenarios import geometry as shared
 
-# 1e-12 [m] on configurations of size ~1 m: a few hundred ulp. Both sides run the same
-# operations in the same order; differences come only from libm/np.roots round-off (the ring
-# stationary angles are polished by Newton steps, so they agree far below this bound).
+# 1e-12 [m] on configurations of size ~1 m: a few hundred ulp. Both sides run the same compiled
+# operations in the same order (the slot form only skips the compaction), so they agree far
+# below this bound.
 TOLERANCE = 1e-12
 
 
@@ -77,21 +82,21 @@ def _compare(kind_a, shape_a, kind_b, shape_b):
                                  np.ascontiguousarray(rotation_a), shared.shape_code(kind_b),
                                  packed_b, np.asarray(position_b),
                                  np.ascontiguousarray(rotation_b), gap, point_a, point_b, frame)
-    w_gap, w_point_a, w_point_b, w_frame = worker.pair_contacts(
-        kind_a, params_a, position_a, rotation_a, kind_b, params_b, position_b, rotation_b)
-    slots = worker.pair_contact_slots(kind_a, params_a, position_a, rotation_a, kind_b,
-                                      params_b, position_b, rotation_b)
+    slots = worker.pair_contact_slots(worker.packed_shape(kind_a, params_a), position_a,
+                                      rotation_a, worker.packed_shape(kind_b, params_b),
+                                      position_b, rotation_b)
     # One slot per candidate the kernel can return; the kept slots, in order, are the shared
     # geometry's (compacted) candidates.
     assert all(len(values) == worker.candidate_count(kind_a, kind_b) for values in slots)
-    assert len(w_gap) == count == int(np.sum(slots[4]))
+    kept = slots[4]
+    assert count == int(np.sum(kept))
     if not worker.drops_candidates(kind_a, kind_b):
         assert count == worker.candidate_count(kind_a, kind_b)
-    np.testing.assert_allclose(w_gap, gap[:count], rtol=0, atol=TOLERANCE)
-    np.testing.assert_allclose(w_point_a, point_a[:count], rtol=0, atol=TOLERANCE)
-    np.testing.assert_allclose(w_point_b, point_b[:count], rtol=0, atol=TOLERANCE)
+    np.testing.assert_allclose(slots[0][kept], gap[:count], rtol=0, atol=TOLERANCE)
+    np.testing.assert_allclose(slots[1][kept], point_a[:count], rtol=0, atol=TOLERANCE)
+    np.testing.assert_allclose(slots[2][kept], point_b[:count], rtol=0, atol=TOLERANCE)
     # Frames are dimensionless: 1e-12 is ~5000 ulp.
-    np.testing.assert_allclose(w_frame, frame[:count], rtol=0, atol=TOLERANCE)
+    np.testing.assert_allclose(slots[3][kept], frame[:count], rtol=0, atol=TOLERANCE)
     return count, slots
 
 
@@ -101,7 +106,7 @@ BOUNDED_PAIRS = [pair for pair in PAIRS if worker.drops_candidates(*pair)]
 
 @pytest.mark.parametrize("pair", PAIRS, ids=[f"{a}-{b}" for a, b in PAIRS])
 @pytest.mark.parametrize("swapped", [False, True], ids=["canonical", "swapped"])
-def test_worker_geometry_matches_shared_geometry(pair, swapped):
+def test_worker_slots_are_the_shared_geometry(pair, swapped):
     kind_a, kind_b = pair
     rng = np.random.default_rng(2 * PAIRS.index(pair) + int(swapped))
     for trial in range(200):
@@ -160,17 +165,30 @@ def test_bounded_face_and_bore_slots_match_shared_geometry(pair, swapped):
     assert kept > 0 and dropped > 0
 
 
-def test_worker_frame_matches_shared_frame_everywhere():
-    rng = np.random.default_rng(7)
-    normals = rng.normal(size=(2000, 3))
-    normals /= np.linalg.norm(normals, axis=1)[:, None]
-    # Include the pole, the singular direction and the axes.
-    extra = [shared.FRAME_POLE, shared.FRAME_SINGULAR_DIRECTION, (1, 0, 0), (0, -1, 0),
-             (0, 0, 1), (0, 0, -1)]
-    for normal in list(normals) + [np.asarray(e, dtype=float) for e in extra]:
-        # Dimensionless, orthonormal rows: 1e-14 is ~50 ulp.
-        np.testing.assert_allclose(worker.contact_frame(normal), shared.contact_frame(normal),
-                                   rtol=0, atol=1e-14)
+def test_the_worker_takes_its_geometry_from_the_kernels():
+    # The worker's module defines only the Siconos-specific functions; every formula (gaps,
+    # frames, quaternions) is the kernels'.
+    own = {name for name, function in inspect.getmembers(worker, inspect.isfunction)
+           if function.__module__ == worker.__name__}
+    assert own == {"candidate_count", "drops_candidates", "unsupported_reason", "packed_shape",
+                   "pair_contact_slots"}
+    assert worker.gaps is gaps
+    assert worker.SHAPE_KINDS == gaps.SHAPE_KIND_NAMES
+
+
+def test_a_journal_beside_its_bore_fills_both_slots_dropped():
+    bore = worker.packed_shape("bore", [0.2, 0.1, 0.0, 2.0 * math.pi])
+    journal = worker.packed_shape("cylinder", [0.19, 0.05])
+    # The journal's centre 1 m along the bore axis: no axial overlap (half-lengths 0.1, 0.05).
+    gap, point_a, _, frame, kept = worker.pair_contact_slots(
+        journal, np.array([0.0, 0.0, 1.0]), np.eye(3), bore, np.zeros(3), np.eye(3))
+    assert kept.tolist() == [False, False]
+    assert gap.tolist() == [0.0, 0.0]
+    assert point_a.tolist() == [[0.0, 0.0, 1.0]] * 2
+    # A normal across the bore axis (z), in an orthonormal frame; 1e-15: a few ulp.
+    assert np.all(np.abs(frame[:, 0, 2]) < 1e-15)
+    for one in frame:
+        np.testing.assert_allclose(one @ one.T, np.eye(3), rtol=0, atol=1e-15)
 
 
 def test_unported_pairs_have_reasons():

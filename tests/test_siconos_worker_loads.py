@@ -2,10 +2,10 @@
 force evaluation (``ref_solver.forces.applied_forces``) at random states, and the adapter
 declares what it does not know UNSUPPORTED.
 
-The worker module runs under Debian's Python; it imports only numpy and its sibling
-``geometry`` (by bare name), so it is imported here from its folder. Siconos
-itself is imported only when a model is built, which these tests never do: they run without
-Siconos.
+The worker module runs under Debian's Python; it imports numpy, its siblings ``geometry`` and
+``project_kernels`` (by bare name) and the project's kernels, so it is imported here from its
+folder. Siconos itself is imported only when a model is built, which these tests never do: they
+run without Siconos.
 """
 
 from __future__ import annotations
@@ -22,8 +22,8 @@ import pytest
 from clearbench.adapters.base import RunSettings, Support
 from clearbench.adapters.siconos import engine as siconos_engine
 from clearbench.adapters.trajectory import RunStatus
+from clearbench.kernels import quaternion, time_profiles
 from clearbench.kernels.quaternion import quat_normalize, quat_to_matrix
-from clearbench.kernels.time_profiles import evaluate_profile, evaluate_profile_slope
 from clearbench.ref_solver.forces import applied_forces, no_angle_memory, rotation_matrices
 from clearbench.ref_solver.scene_system import build_system
 from clearbench.scenarios.library import get_scene, scene_names
@@ -185,16 +185,9 @@ def test_projection_refuses_pairs_that_drop_candidates():
     assert "pair:arc-bore" in trajectory.message
 
 
-@pytest.mark.parametrize("times, values", [
-    ((0.0,), (2.0,)),
-    ((0.0, 0.7, 0.7, 2.0), (0.0, 0.0, 0.2, 0.2)),      # switched on at 0.7 (the C-60 plunger)
-    ((0.1, 0.5, 0.9, 0.9, 1.5), (1.0, -2.0, 3.0, 0.5, 0.0)),
-])
-def test_worker_time_profiles_are_the_floor_kernels(worker, times, values):
-    """The worker's copies of the profile value and slope (it cannot import clearbench) give
-    bitwise the values of :mod:`clearbench.kernels.time_profiles`, knots and jumps included."""
-    t = np.concatenate((np.linspace(-0.5, 2.5, 301), times))
-    assert [worker.evaluate_profile(times, values, x) for x in t] == \
-        evaluate_profile(times, values, t).tolist()
-    assert [worker.profile_rate(times, values, x) for x in t] == \
-        evaluate_profile_slope(times, values, t).tolist()
+def test_the_worker_takes_quaternions_and_time_profiles_from_the_kernels(worker):
+    """The worker's rotations and driver profiles are the floor's kernels (imported through
+    ``project_kernels``, by path under Debian's Python), not copies of them."""
+    assert worker.quaternion is quaternion
+    assert worker.time_profiles is time_profiles
+    assert not {"evaluate_profile", "profile_rate", "_conjugate"} & set(vars(worker))

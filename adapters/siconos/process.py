@@ -148,7 +148,8 @@ def run_worker(script: str | Path, inputs: dict, timeout: float = 600.0) -> Work
 
     Parameters
     ----------
-    script : path of the worker script (it must not import clearbench).
+    script : path of the worker script (of clearbench it may import only the kernels, by path:
+        ``worker/project_kernels.py``).
     inputs : dict of arrays / scalars / strings saved to INPUT.npz.
     timeout : wall-clock limit of the process, seconds.
     """

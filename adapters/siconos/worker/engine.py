@@ -1,8 +1,9 @@
 """Siconos worker: run one scene with the Siconos kernel and return the common trajectory.
 
 Runs under Debian's /usr/bin/python3 with a clean environment (Siconos 4.4 imports only with
-Debian's numpy); it imports nothing from clearbench, only numpy, siconos and its sibling
-``geometry`` (the script's folder is on ``sys.path``).
+Debian's numpy); it imports numpy, siconos, its siblings ``geometry`` and ``project_kernels``
+(the script's folder is on ``sys.path``) and, through the latter, the project's kernels
+(``clearbench.kernels``, imported by path: nothing else of clearbench).
 
 Protocol (files, never stdout, which Siconos fills with noise such as "BLOCK COPY !!!!"):
 
@@ -57,6 +58,7 @@ from time import perf_counter
 
 import geometry
 import numpy as np
+from project_kernels import quaternion, time_profiles
 
 #: Keys of ``settings_json``.
 SETTINGS_KEYS = (
@@ -113,35 +115,6 @@ def siconos_builtin_frame(normal):
     return np.array([n, first, np.cross(n, first)])
 
 
-# The two profile functions below copy clearbench.kernels.time_profiles (profile_value,
-# profile_slope) on purpose: this script runs under Debian's Python, which has neither numba nor
-# clearbench. tests/test_siconos_worker_loads.py holds them bitwise equal to the kernels.
-def evaluate_profile(times, values, t):
-    """Piecewise-linear profile value at t (``clearbench.kernels.time_profiles.profile_value``:
-    constant outside, right value at a jump)."""
-    times = np.asarray(times, dtype=float)
-    values = np.asarray(values, dtype=float)
-    if len(times) == 1 or t < times[0]:
-        return float(values[0])
-    if t >= times[-1]:
-        return float(values[-1])
-    index = int(np.clip(np.searchsorted(times, t, side="right"), 1, len(times) - 1))
-    t0, t1 = times[index - 1], times[index]
-    v0, v1 = values[index - 1], values[index]
-    if t1 <= t0:
-        return float(v1)
-    return float(v0 + min(max((t - t0) / (t1 - t0), 0.0), 1.0) * (v1 - v0))
-
-
-def profile_rate(times, values, t):
-    """Slope of the current segment of a piecewise-linear position profile, 0 outside
-    (``clearbench.kernels.time_profiles.profile_slope``)."""
-    for i in range(len(times) - 1):
-        if times[i + 1] > times[i] and times[i] <= t < times[i + 1]:
-            return (values[i + 1] - values[i]) / (times[i + 1] - times[i])
-    return 0.0
-
-
 # ---------------------------------------------------------------------------- scene model
 class Body:
     """A scene body: inertial data, initial Siconos state, shapes placed at its centre of mass."""
@@ -154,10 +127,11 @@ class Body:
         self.mass = float(data.get("mass", 1.0))
         self.inertia = np.array(data.get("inertia", np.eye(3)), dtype=float)
         self.com = np.array(data.get("center_of_mass", (0.0, 0.0, 0.0)), dtype=float)
-        quaternion = geometry.quat_normalize(data.get("orientation", (1.0, 0.0, 0.0, 0.0)))
-        rotation = geometry.quat_to_matrix(quaternion)
+        orientation = quaternion.quat_normalize(
+            np.array(data.get("orientation", (1.0, 0.0, 0.0, 0.0)), dtype=float))
+        rotation = quaternion.quat_to_matrix(orientation)
         position = np.array(data.get("position", (0.0, 0.0, 0.0)), dtype=float)
-        self.q0 = np.concatenate([position + rotation @ self.com, quaternion])
+        self.q0 = np.concatenate([position + rotation @ self.com, orientation])
         self.rotation0 = rotation
         velocity = np.array(data.get("velocity", (0.0, 0.0, 0.0)), dtype=float)
         omega = np.array(data.get("angular_velocity", (0.0, 0.0, 0.0)), dtype=float)
@@ -166,10 +140,10 @@ class Body:
         for shape in data.get("shapes", []):
             kind = shape["kind"]
             self.shapes[shape["name"]] = (
-                kind, _packed_parameters(shape),
+                kind, geometry.packed_shape(kind, _packed_parameters(shape)),
                 np.array(shape.get("position", (0.0, 0.0, 0.0)), dtype=float) - self.com,
-                geometry.quat_to_matrix(geometry.quat_normalize(
-                    shape.get("orientation", (1.0, 0.0, 0.0, 0.0)))),
+                quaternion.quat_to_matrix(quaternion.quat_normalize(np.array(
+                    shape.get("orientation", (1.0, 0.0, 0.0, 0.0)), dtype=float))),
             )
         self.ds = None  # the Siconos dynamical system (None for a fixed body)
 
@@ -234,7 +208,7 @@ class Pair:
 
     @staticmethod
     def _placement(shape, q):
-        rotation = geometry.quat_to_matrix(q[3:7])
+        rotation = quaternion.quat_to_matrix(q[3:7])
         return q[:3] + rotation @ shape[2], rotation @ shape[3], rotation
 
     def evaluate(self, q_a, q_b):
@@ -252,8 +226,8 @@ class Pair:
             position_a, orientation_a, _ = self._fixed_a
             position_b, orientation_b, _ = self._fixed_b
             gap, point_a, point_b, frame, kept = geometry.pair_contact_slots(
-                self.shape_a[0], self.shape_a[1], position_a, orientation_a,
-                self.shape_b[0], self.shape_b[1], position_b, orientation_b)
+                self.shape_a[1], position_a, orientation_a, self.shape_b[1], position_b,
+                orientation_b)
             gap = np.where(kept, gap - self.offset, geometry.DROPPED_GAP)
             self.dropped += int(np.count_nonzero(~kept))
             self._value = (gap, point_a, point_b, frame)
@@ -314,12 +288,12 @@ def define_siconos_classes(sk):
             second = np.array(q0.vector(1)) if self.two_bodies else None
             _, point_1, point_2, frame, q_1, q_2 = self._geometry(first, second)
             jacobian = self.jachqT()
-            rotation_1 = geometry.quat_to_matrix(q_1[3:7])
+            rotation_1 = quaternion.quat_to_matrix(q_1[3:7])
             # velocity of the contact point of body 1: v + (R w) x r = v - [r]x R w (w body)
             jacobian[:, 0:3] = frame
             jacobian[:, 3:6] = -frame @ _skew(point_1 - q_1[:3]) @ rotation_1
             if second is not None:
-                rotation_2 = geometry.quat_to_matrix(q_2[3:7])
+                rotation_2 = quaternion.quat_to_matrix(q_2[3:7])
                 jacobian[:, 6:9] = -frame
                 jacobian[:, 9:12] = frame @ _skew(point_2 - q_2[:3]) @ rotation_2
             self.frame = frame
@@ -373,8 +347,8 @@ def define_siconos_classes(sk):
         def computePrescribedVelocity(self, time):
             target = self.prescribedVelocity()
             for i, (scale, quantity, times, values) in enumerate(self.drivers):
-                rate = evaluate_profile(times, values, time) if quantity == "velocity" \
-                    else profile_rate(times, values, time)
+                rate = time_profiles.profile_value(times, values, time) \
+                    if quantity == "velocity" else time_profiles.profile_slope(times, values, time)
                 target[i] = scale * rate
 
     return ContactRelation, BuiltinFrameRelation, LoadedDS, DriverBC
@@ -413,7 +387,7 @@ class Loads:
 
     def _point(self, body, local):
         q, twist = body.state()
-        rotation = geometry.quat_to_matrix(q[3:7])
+        rotation = quaternion.quat_to_matrix(q[3:7])
         arm = rotation @ (np.asarray(local, dtype=float) - body.com)
         velocity = twist[:3] + np.cross(rotation @ twist[3:6], arm)
         return q[:3] + arm, velocity, arm, rotation
@@ -422,7 +396,7 @@ class Loads:
         """World force (3,) [F] and moment about the centre of mass in body axes (3,) [F L]."""
         body = self.bodies[name]
         q, twist = body.state()
-        rotation = geometry.quat_to_matrix(q[3:7])
+        rotation = quaternion.quat_to_matrix(q[3:7])
         force = body.mass * self.gravity
         moment_world = np.zeros(3)
         for load in self.per_body[name]:
@@ -500,7 +474,7 @@ class Loads:
         """The body's angle about the law's axis, continuous across steps (``continuous_angle``
         with the angle remembered at the last step)."""
         q, _ = self.bodies[body_name].state()
-        raw = twist_angle(geometry.quat_to_matrix(q[3:7]), axis)
+        raw = twist_angle(quaternion.quat_to_matrix(q[3:7]), axis)
         return continuous_angle(raw, self.angle_memory.get((load["name"], body_name), math.nan))
 
     def remember_angles(self):
@@ -517,16 +491,17 @@ class Loads:
         body_b = self.bodies[load["body_b"]]
         q_a, twist_a = body_a.state()
         q_b, twist_b = body_b.state()
-        rotation_a = geometry.quat_to_matrix(q_a[3:7])
-        rotation_b = geometry.quat_to_matrix(q_b[3:7])
+        rotation_a = quaternion.quat_to_matrix(q_a[3:7])
+        rotation_b = quaternion.quat_to_matrix(q_b[3:7])
         axis0 = np.array(load.get("axis", (0.0, 0.0, 1.0)), dtype=float)
         axis_local = body_a.rotation0.T @ axis0
         axis = rotation_a @ axis_local
         # phi: rotation of B relative to A about the axis since t = 0 (metrics.relative_angle)
         p_a, p_b = q_a[3:7], q_b[3:7]
-        relative = geometry.quat_multiply(_conjugate(p_a), p_b)
-        relative0 = geometry.quat_multiply(_conjugate(body_a.q0[3:7]), body_b.q0[3:7])
-        change = geometry.quat_multiply(_conjugate(relative0), relative)
+        relative = quaternion.quat_multiply(quaternion.quat_conjugate(p_a), p_b)
+        relative0 = quaternion.quat_multiply(quaternion.quat_conjugate(body_a.q0[3:7]),
+                                             body_b.q0[3:7])
+        change = quaternion.quat_multiply(quaternion.quat_conjugate(relative0), relative)
         phi = 2.0 * math.atan2(float(change[1:] @ axis_local), float(change[0]))
         previous = self._unwrap.get(load["name"], phi)
         phi = previous + math.remainder(phi - previous, 2.0 * math.pi)
@@ -580,10 +555,6 @@ def _law_action(application, scalar, scalar_is_moment, rotation, com):
     return value, np.cross(arm, value)
 
 
-def _conjugate(q):
-    return np.array([q[0], -q[1], -q[2], -q[3]])
-
-
 # ---------------------------------------------------------------------------- the run
 class SiconosModel:
     """The Siconos model of a scene and its stepping; every Siconos object stays referenced."""
@@ -628,8 +599,8 @@ class SiconosModel:
                     index, scale = self._driver_index(body, driver["component"])
                     indices.append(index)
                     specs.append((scale, driver.get("quantity", "velocity"),
-                                  list(driver.get("times", (0.0,))),
-                                  list(driver.get("values", (0.0,)))))
+                                  np.array(driver.get("times", (0.0,)), dtype=float),
+                                  np.array(driver.get("values", (0.0,)), dtype=float)))
                 bc = DriverBC(indices, specs)
                 ds.setBoundaryConditions(bc)
                 self.keep.append(bc)
@@ -866,7 +837,7 @@ class SiconosModel:
         out["times"][i] = t
         for b, body in enumerate(self.body_list):
             q, twist = body.state()
-            rotation = geometry.quat_to_matrix(q[3:7])
+            rotation = quaternion.quat_to_matrix(q[3:7])
             out["positions"][i, b] = q[:3] - rotation @ body.com
             out["orientations"][i, b] = q[3:7]
             out["velocities"][i, b] = twist[:3]
