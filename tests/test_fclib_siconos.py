@@ -6,7 +6,7 @@ Skipped when Siconos cannot be imported by /usr/bin/python3 (install: `make sico
 import numpy as np
 import pytest
 
-from clearbench.adapters.siconos import process as siconos_process
+from clearbench.adapters.siconos import run as siconos_process
 from clearbench.adapters.siconos.fc3d import (
     siconos_compute_error,
     siconos_read_text_file,

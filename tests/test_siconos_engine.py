@@ -17,7 +17,7 @@ from clearbench.adapters import engine_availability
 from clearbench.adapters.base import RunSettings, Support
 from clearbench.adapters.reference.engine import create as create_reference
 from clearbench.adapters.siconos import engine as siconos_engine
-from clearbench.adapters.siconos import process as siconos_process
+from clearbench.adapters.siconos import run as siconos_process
 from clearbench.adapters.trajectory import RunStatus, Trajectory
 from clearbench.harness.measure import series as metrics
 from clearbench.harness.measure.expectation_figures import evaluate

@@ -28,8 +28,8 @@ HARNESS_DEFAULTS = HarnessDefaults(
 
 
 def availability() -> tuple[bool, str]:
-    """Whether Debian's interpreter imports Siconos (:func:`.process.siconos_availability`:
+    """Whether Debian's interpreter imports Siconos (:func:`.run.siconos_availability`:
     a probe in that interpreter, its answer cached); never raises."""
-    from clearbench.adapters.siconos.process import siconos_availability
+    from clearbench.adapters.siconos.run import siconos_availability
 
     return siconos_availability()

@@ -3,7 +3,7 @@ nonsmooth engine.
 
 Siconos imports only under /usr/bin/python3 with Debian's numpy and a clean environment, so
 every run goes through a worker process (:mod:`.worker.engine`, started by
-:func:`~.process.run_worker`): this side sends the scene (JSON, clearance joints
+:func:`~.run.run_worker`): this side sends the scene (JSON, clearance joints
 expanded) and the settings, the worker builds the model with the kernel API and returns the
 common trajectory as .npz. A crash or a hang of the worker is a recorded outcome (CRASHED /
 TIMED_OUT), never an exception.
@@ -51,7 +51,7 @@ import numpy as np
 
 from clearbench.adapters.base import ModuleEngine, RunSettings
 from clearbench.adapters.siconos import HARNESS_DEFAULTS, capabilities
-from clearbench.adapters.siconos.process import (
+from clearbench.adapters.siconos.run import (
     WorkerStatus,
     run_worker,
 )

@@ -1,7 +1,7 @@
 """Siconos's fc3d solvers (NSGS with Alart–Curnier local Newton, NSN-AC) on a ContactProblem.
 
 Parent side of :mod:`.worker.fc3d`; everything runs in a separate Debian Python process
-(see :mod:`.process`). Used to validate our solvers side by side with Siconos.
+(see :mod:`.run`). Used to validate our solvers side by side with Siconos.
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from clearbench.adapters.siconos.process import WorkerStatus, run_worker
+from clearbench.adapters.siconos.run import WorkerStatus, run_worker
 from clearbench.ref_solver.contact_problem import ContactProblem
 
 WORKER_SCRIPT = Path(__file__).parent / "worker" / "fc3d.py"

@@ -6,7 +6,7 @@ import csv
 import math
 from pathlib import Path
 
-from clearbench.adapters.siconos.process import siconos_availability
+from clearbench.adapters.siconos.run import siconos_availability
 from clearbench.harness.cli.commands import command_help
 from clearbench.harness.cli.common import UserError
 from clearbench.harness.fclib.compare import (

@@ -15,7 +15,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from clearbench.adapters.siconos.fc3d import SICONOS_SOLVERS, solve_with_siconos
-from clearbench.adapters.siconos.process import siconos_available
+from clearbench.adapters.siconos.run import siconos_available
 from clearbench.harness.fclib.problems import LoadedProblem
 from clearbench.ref_solver.contact_problem import ContactProblem, SolverOptions
 from clearbench.ref_solver.fc3d_residual import residual_both
