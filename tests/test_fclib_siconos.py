@@ -6,7 +6,7 @@ Skipped when Siconos cannot be imported by /usr/bin/python3 (install: `make sico
 import numpy as np
 import pytest
 
-from clearbench.adapters.siconos import run as siconos_process
+from clearbench.adapters.siconos import run as siconos_run
 from clearbench.adapters.siconos.fc3d import (
     siconos_compute_error,
     siconos_read_text_file,
@@ -27,7 +27,7 @@ LOCAL_AND_CONDENSED = [
     "local_problem_test.hdf5",
 ]
 
-needs_siconos = pytest.mark.skipif(not siconos_process.siconos_available(),
+needs_siconos = pytest.mark.skipif(not siconos_run.siconos_available(),
                                    reason="Debian's python3-siconos is not installed")
 
 
@@ -77,12 +77,12 @@ def test_siconos_solvers_answer_through_the_worker(solver):
 
 
 def test_missing_siconos_is_reported_not_raised(monkeypatch):
-    monkeypatch.setattr(siconos_process, "SICONOS_PYTHON", "/nonexistent/python3")
-    siconos_process.siconos_availability.cache_clear()
+    monkeypatch.setattr(siconos_run, "SICONOS_PYTHON", "/nonexistent/python3")
+    siconos_run.siconos_availability.cache_clear()
     try:
         problem = load_problem(DATA / "OneObject-i1028-138.hdf5.dat").problem
         result = solve_with_siconos(problem, "siconos-nsgs-ac")
         assert result.status == "unavailable"
         assert "unavailable" in result.message
     finally:
-        siconos_process.siconos_availability.cache_clear()
+        siconos_run.siconos_availability.cache_clear()

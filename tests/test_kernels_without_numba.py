@@ -19,7 +19,7 @@ import numba
 import numpy as np
 import pytest
 
-from clearbench.adapters.siconos import process
+from clearbench.adapters.siconos import run as siconos_run
 from clearbench.adapters.siconos.worker import project_kernels
 from clearbench.kernels import frames, gaps, jit, quaternion, time_profiles
 
@@ -153,14 +153,14 @@ def test_the_kernels_give_the_compiled_numbers_with_numba_unimportable(tmp_path)
 
 
 def test_the_siconos_worker_interpreter_runs_the_kernels(tmp_path):
-    interpreter = process.SICONOS_PYTHON
+    interpreter = siconos_run.SICONOS_PYTHON
     if not Path(interpreter).exists():
         pytest.skip(f"{interpreter} not found")
     probe = subprocess.run([interpreter, "-c", "import numpy"], capture_output=True,
-                           env=process.clean_environment())
+                           env=siconos_run.clean_environment())
     if probe.returncode != 0:
         pytest.skip(f"{interpreter} has no numpy")
-    plain = _run_battery(tmp_path, interpreter, "worker", env=process.clean_environment())
+    plain = _run_battery(tmp_path, interpreter, "worker", env=siconos_run.clean_environment())
     # The worker imports the kernels and nothing else of the project.
     assert set(plain["modules"]) == {
         "clearbench", "clearbench.kernels", "clearbench.kernels.frames",

@@ -17,7 +17,7 @@ from clearbench.adapters import engine_availability
 from clearbench.adapters.base import RunSettings, Support
 from clearbench.adapters.reference.engine import create as create_reference
 from clearbench.adapters.siconos import engine as siconos_engine
-from clearbench.adapters.siconos import run as siconos_process
+from clearbench.adapters.siconos import run as siconos_run
 from clearbench.adapters.trajectory import RunStatus, Trajectory
 from clearbench.harness.measure import series as metrics
 from clearbench.harness.measure.expectation_figures import evaluate
@@ -29,7 +29,7 @@ from clearbench.scenarios.loads import LinearSpringDamper, Moment, PointForce
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.shapes import Box, Plane
 
-needs_siconos = pytest.mark.skipif(not siconos_process.siconos_availability()[0],
+needs_siconos = pytest.mark.skipif(not siconos_run.siconos_availability()[0],
                                    reason="Debian's python3-siconos is not installed")
 
 
@@ -62,8 +62,8 @@ def _incline(angle_degrees: float, friction: float) -> Scene:
 # ---------------------------------------------------------------------------- no Siconos needed
 def test_absent_siconos_is_reported_unavailable_and_runs_are_unsupported(monkeypatch, tmp_path):
     missing = str(tmp_path / "no-python3")
-    monkeypatch.setattr(siconos_process, "SICONOS_PYTHON", missing)
-    siconos_process.siconos_availability.cache_clear()
+    monkeypatch.setattr(siconos_run, "SICONOS_PYTHON", missing)
+    siconos_run.siconos_availability.cache_clear()
     try:
         availability = engine_availability("siconos")
         assert not availability.available
@@ -73,7 +73,7 @@ def test_absent_siconos_is_reported_unavailable_and_runs_are_unsupported(monkeyp
         assert trajectory.status is RunStatus.UNSUPPORTED
         assert "unavailable" in trajectory.message
     finally:
-        siconos_process.siconos_availability.cache_clear()
+        siconos_run.siconos_availability.cache_clear()
 
 
 def test_the_probe_answer_is_kept_per_install_state(monkeypatch, tmp_path):
@@ -82,21 +82,21 @@ def test_the_probe_answer_is_kept_per_install_state(monkeypatch, tmp_path):
     listing = tmp_path / "python3-siconos.list"
     listing.write_text("/usr/lib/python3/dist-packages/siconos\n")
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
-    monkeypatch.setattr(siconos_process, "DPKG_LIST", listing)
+    monkeypatch.setattr(siconos_run, "DPKG_LIST", listing)
     probes = []
-    monkeypatch.setattr(siconos_process, "_probe",
+    monkeypatch.setattr(siconos_run, "_probe",
                         lambda: probes.append(1) or (True, "Debian python3-siconos 4.4"))
     try:
         for _ in range(2):
-            siconos_process.siconos_availability.cache_clear()
-            assert siconos_process.siconos_availability() == (True, "Debian python3-siconos 4.4")
+            siconos_run.siconos_availability.cache_clear()
+            assert siconos_run.siconos_availability() == (True, "Debian python3-siconos 4.4")
         assert len(probes) == 1
         listing.write_text("/usr/lib/python3/dist-packages/siconos\n/usr/share/doc\n")
-        siconos_process.siconos_availability.cache_clear()
-        siconos_process.siconos_availability()
+        siconos_run.siconos_availability.cache_clear()
+        siconos_run.siconos_availability()
         assert len(probes) == 2
     finally:
-        siconos_process.siconos_availability.cache_clear()
+        siconos_run.siconos_availability.cache_clear()
 
 
 def test_capabilities_name_unsupported_pairs_with_reasons():
