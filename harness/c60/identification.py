@@ -520,7 +520,7 @@ def write_markdown(study: Identification, path: Path, preset: str, on_horizon: f
     for key, run in study.runs.items():
         lines.append(f"| {key} | {run.scene.name} | {run.status} | "
                      f"{run.steps} | {run.stepping_seconds:.0f} | "
-                     f"{len(run.unconverged)} |")
+                     f"{run.unconverged_count} |")
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text("\n".join(lines) + "\n")
 

@@ -88,6 +88,11 @@ class Run:
         return list(self.trajectory.unconverged_steps)
 
     @property
+    def unconverged_count(self) -> int:
+        """How many steps' contact problem did not converge (all of them)."""
+        return 0 if self.trajectory is None else int(self.trajectory.unconverged_count)
+
+    @property
     def unconverged_projections(self) -> list:
         """Steps whose projection did not reach its tolerance."""
         if self.trajectory is None:

@@ -585,7 +585,7 @@ def write_markdown(report: ValidationReport, path: Path, figures: dict[str, Path
                                                               else "")
         lines.append(f"| {key} | {run.scene.name} | {run.status} | "
                      f"{run.steps} | "
-                     f"{run.stepping_seconds:.0f} | {len(unconverged)}"
+                     f"{run.stepping_seconds:.0f} | {run.unconverged_count}"
                      f"{' (' + listed + ')' if unconverged else ''} | {run.penetration:.2e} |")
     if figures:
         lines += ["", "## Figures", ""]
@@ -624,7 +624,7 @@ def write_json(report: ValidationReport, path: Path, figures: dict[str, Path],
         "runs": [{"key": key, "scene": run.scene.name, "steps": run.steps,
                   "stepping_seconds": _number(run.stepping_seconds),
                   "status": run.status, "message": run.message,
-                  "unconverged_steps": len(run.unconverged),
+                  "unconverged_steps": run.unconverged_count,
                   "unconverged_projections": len(run.unconverged_projections),
                   "max_penetration_mm": _number(run.penetration), "store_key": run.store_key}
                  for key, run in report.runs.items()],
@@ -697,7 +697,7 @@ def _trip_failure(run: Run) -> str:
     trajectory = run.trajectory
     projections = run.unconverged_projections
     depth = metrics.penetration(run.scene, trajectory)
-    text = (f"c60-trip: {len(run.unconverged)} of {trajectory.steps} steps whose contact "
+    text = (f"c60-trip: {run.unconverged_count} of {trajectory.steps} steps whose contact "
             f"problem did not converge {run.unconverged[:5]}, {len(projections)} whose "
             f"projection did not reach its tolerance {projections[:5]}")
     if depth.size:
