@@ -21,10 +21,7 @@ demo: $(STAMP)
 lint: $(STAMP)
 	$(PY) -m ruff check .
 
-# The numba kernels are compiled first, in parallel workers (`clearbench compile`), so that the
-# tests load them instead of compiling them one after the other.
 test: $(STAMP) lint siconos chromium
-	$(VENV)/bin/clearbench compile
 	$(PY) -m pytest -m "not slow" --durations=30
 
 # The quick regression suite against the committed baselines (CI runs it after the tests).
