@@ -18,6 +18,7 @@ the old code after that module is edited (it did once, and hid a fix).
 import functools
 import hashlib
 import importlib.util
+import json
 import os
 import shutil
 from pathlib import Path
@@ -95,6 +96,17 @@ def _checkout_cache_root() -> Path:
     checkout = hashlib.sha1(str(Path(__file__).resolve().parent.parent).encode()).hexdigest()
     return Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) \
         / "clearbench-numba-checkouts" / checkout[:12]
+
+
+def write_json(path: Path, data, **dumps_options) -> None:
+    """Write ``data`` as JSON to ``path`` (its folder made) all at once: into a temporary file
+    beside it, renamed over it, so that a reader or a process killed mid-write never leaves a
+    torn file, and concurrent writers each leave a whole one. ``dumps_options`` go to
+    :func:`json.dumps`. Raises OSError where the folder cannot be written."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    partial = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+    partial.write_text(json.dumps(data, **dumps_options), encoding="utf-8")
+    partial.replace(path)
 
 
 def checkout_cache_dir() -> Path:

@@ -20,6 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
+import clearbench
+
 #: Interpreter that has Debian's python3-siconos.
 SICONOS_PYTHON = "/usr/bin/python3"
 
@@ -129,10 +131,7 @@ def siconos_availability() -> tuple[bool, str]:
     available, detail = _probe()
     if available and state is not None:
         try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            partial = path.with_suffix(f".{os.getpid()}.tmp")
-            partial.write_text(json.dumps({"state": state, "detail": detail}))
-            partial.replace(path)
+            clearbench.write_json(path, {"state": state, "detail": detail})
         except OSError:  # an unwritable cache costs the probe next time
             pass
     return available, detail

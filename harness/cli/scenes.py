@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
 import textwrap
 
@@ -107,10 +106,7 @@ def scene_features(names: list[str]) -> dict[str, list[str]]:
         cached[name] = sorted(get_entry(name).build().features)
     if missing:
         try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            partial = path.with_suffix(f".{os.getpid()}.tmp")
-            partial.write_text(json.dumps(cached, indent=1, sort_keys=True))
-            partial.replace(path)
+            clearbench.write_json(path, cached, indent=1, sort_keys=True)
         except OSError:  # a read-only cache only costs the builds next time
             pass
     return {name: cached[name] for name in names}

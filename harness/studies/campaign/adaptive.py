@@ -29,6 +29,7 @@ from dataclasses import asdict
 
 import numpy as np
 
+import clearbench
 from clearbench.harness.run.store import ResultsStore
 from clearbench.harness.studies.campaign.definition import CampaignDefinition, CampaignError
 from clearbench.harness.studies.campaign.execution import (
@@ -73,11 +74,7 @@ def load_state(store: ResultsStore, definition: CampaignDefinition) -> dict:
 
 
 def _save_state(store: ResultsStore, definition: CampaignDefinition, state: dict) -> None:
-    path = state_path(store, definition)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    temporary = path.with_suffix(".tmp")
-    temporary.write_text(json.dumps(state, indent=1, default=float), encoding="utf-8")
-    temporary.replace(path)
+    clearbench.write_json(state_path(store, definition), state, indent=1, default=float)
 
 
 def design_table(definition: CampaignDefinition, store: ResultsStore, count: int,

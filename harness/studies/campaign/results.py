@@ -15,6 +15,7 @@ from dataclasses import asdict
 
 import numpy as np
 
+import clearbench
 from clearbench.harness.measure.series import output_values
 from clearbench.harness.run.store import ResultsStore
 from clearbench.harness.studies.campaign.definition import CampaignDefinition, OutputSpec
@@ -95,9 +96,7 @@ def campaign_table(definition: CampaignDefinition, store: ResultsStore, samples=
         rows.append(row)
     if changed:
         whole[digest] = cached
-        temporary = path.with_suffix(".tmp")
-        temporary.write_text(json.dumps(whole), encoding="utf-8")
-        temporary.replace(path)
+        clearbench.write_json(path, whole)
     return pd.DataFrame(rows)
 
 
