@@ -60,6 +60,12 @@ class Capability:
     detail: str = ""
 
 
+#: What every engine that lines a bore with pieces does with a partial bore's ``depth`` (how
+#: far its solid reaches behind the surface: deeper partners are behind it, not in it).
+BORE_DEPTH_NOTE = ("a bore's depth is not modelled: the lining's own thickness stands for the "
+                   "solid behind the surface")
+
+
 def unknown_feature(engine: str, feature: str) -> Capability:
     """The answer of every engine for a feature it does not know."""
     return Capability(Support.UNSUPPORTED,

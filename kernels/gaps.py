@@ -851,7 +851,7 @@ def _inside_face(plane_position, plane_rotation, half_x, half_y, radius, depth, 
     """True if the staged contact ``k`` lies in the face: its point on A (row 1 of the stage)
     within |x| <= half_x and |y| <= half_y (rectangle, radius < 0) or x^2 + y^2 <= radius^2
     (disc) in the face's frame, and its gap not below -depth (depth 0: no bound)."""
-    if depth > 0.0 and stage[k, 2, 0] < -depth:
+    if not _within_depth(depth, stage, k):
         return False
     point = (stage[k, 1, 0], stage[k, 1, 1], stage[k, 1, 2])
     local = _to_local(plane_position, plane_rotation, point)
@@ -984,23 +984,33 @@ def _cylinder_in_bore(journal_position, journal_rotation, journal_radius, journa
 def _bore_slots(kind_a, params_a, position_a, rotation_a, params_b, position_b, rotation_b,
                 stage):
     """A circle, arc or journal (A) inside a bore (B): (slots, kept_0, kept_1), every slot
-    staged (:func:`_ring_in_bore`, :func:`_cylinder_in_bore`); slots -1 for any other A."""
+    staged (:func:`_ring_in_bore`, :func:`_cylinder_in_bore`); slots -1 for any other A. A
+    slot whose gap is below -depth (``params_b[4]`` > 0) is not kept: A is behind the bore's
+    solid, not in it."""
     bore_span = params_b[3] - params_b[2]
     if kind_a == CIRCLE:
         kept = _ring_in_bore(position_a, rotation_a, params_a[0], 0.0, _TWO_PI, False,
                              position_b, rotation_b, params_b[0], params_b[1], params_b[2],
                              bore_span, True, 0, stage)
-        return 1, kept == 1, False
+        return 1, kept == 1 and _within_depth(params_b[4], stage, 0), False
     if kind_a == ARC:
         kept = _ring_in_bore(position_a, rotation_a, params_a[0], params_a[1],
                              params_a[2] - params_a[1], True, position_b, rotation_b,
                              params_b[0], params_b[1], params_b[2], bore_span, True, 0, stage)
-        return 1, kept == 1, False
+        return 1, kept == 1 and _within_depth(params_b[4], stage, 0), False
     if kind_a == CYLINDER:
-        return _cylinder_in_bore(position_a, rotation_a, params_a[0], params_a[1], position_b,
-                                 rotation_b, params_b[0], params_b[1], params_b[2], bore_span,
-                                 stage)
+        slots, kept_0, kept_1 = _cylinder_in_bore(
+            position_a, rotation_a, params_a[0], params_a[1], position_b, rotation_b,
+            params_b[0], params_b[1], params_b[2], bore_span, stage)
+        return (slots, kept_0 and _within_depth(params_b[4], stage, 0),
+                kept_1 and slots == 2 and _within_depth(params_b[4], stage, 1))
     return -1, False, False
+
+
+@njit(cache=True, inline="always")
+def _within_depth(depth, stage, k):
+    """False if the staged contact ``k`` lies deeper than ``depth`` (> 0; 0: no bound)."""
+    return not (depth > 0.0 and stage[k, 2, 0] < -depth)
 
 
 @njit(cache=True, inline="always")

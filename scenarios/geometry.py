@@ -71,7 +71,8 @@ disc-X                 candidates whose point on the face lies inside the face (
 circle-bore       0-1  ring INSIDE a bore: g = R_bore - (largest distance of a ring point from
 arc-bore               the bore axis), n radially outward from that ring point (parallel axes at
                        eccentricity e: g = R_bore - R_ring - e). Kept only if the point on the
-                       bore lies in its angles and |z| <= half_length (a concave CAD patch).
+                       bore lies in its angles and |z| <= half_length (a concave CAD patch),
+                       and its gap is not below -depth (behind the solid, as for faces).
 cylinder-bore     0-2  journal INSIDE a bore: one candidate at each end of the axial overlap
                        (the radial gap is concave along the axis, so these are its minima): the
                        journal's end rim when it is inside the bore, else the bore's end rim
@@ -208,7 +209,7 @@ _PACKED_FIELDS: dict[str, tuple[str, ...]] = {
     "arc": ("radius", "start_angle", "end_angle"),
     "rectangle": ("half_extents", "depth"),
     "disc": ("radius", "depth"),
-    "bore": ("radius", "half_length", "start_angle", "end_angle"),
+    "bore": ("radius", "half_length", "start_angle", "end_angle", "depth"),
 }
 
 
@@ -277,7 +278,7 @@ def pack_shape_parameters(shape: Shape) -> np.ndarray:
     arc       [radius, start_angle, end_angle] (rad)
     rectangle [half_x, half_y, depth] (depth 0: unbounded)
     disc      [radius, depth] (depth 0: unbounded)
-    bore      [radius, half_length, start_angle, end_angle] (rad)
+    bore      [radius, half_length, start_angle, end_angle, depth] (rad; depth 0: unbounded)
     ========  ============================================
 
     Unused entries are 0. Lengths in the scene's unit.

@@ -196,16 +196,29 @@ class Disc(Shape):
 
 @dataclass(frozen=True)
 class Bore(Shape):
+    """A concave cylinder about its frame's z axis, |z| <= half_length, between
+    ``start_angle`` and ``end_angle`` [rad] from +x: a hole that rings, arcs and journals sit
+    inside, the material outside the radius.
+
+    ``depth`` [L] is how far the solid reaches behind the surface, as for :class:`Rectangle`:
+    a partner more than that outside the radius has gone round behind the part (a partial
+    bore, a concave patch, can be left that way), it is not in it, and no contact is reported.
+    None: no bound.
+    """
+
     kind: ClassVar[str] = "bore"
     radius: float = field(default=0.1, metadata=dim(LENGTH))
     half_length: float = field(default=0.5, metadata=dim(LENGTH))
     start_angle: float = field(default=0.0, metadata=dimensionless())
     end_angle: float = field(default=2.0 * math.pi, metadata=dimensionless())
+    depth: float | None = field(default=None, metadata=dim(LENGTH))
 
     def _check_parameters(self) -> None:
         object.__setattr__(self, "radius", check_positive("radius", self.radius))
         object.__setattr__(self, "half_length", check_positive("half_length", self.half_length))
         _check_angle_range(self)
+        if self.depth is not None:
+            object.__setattr__(self, "depth", check_positive("depth", self.depth))
 
 
 #: Every shape class by its ``kind`` string (the ``kind`` key of the dict/TOML form).

@@ -157,6 +157,37 @@ def test_bore_patch_and_length_bound_the_ring_contact():
     assert contacts(G.CIRCLE, params(1.0), beyond, IDENTITY, *patch)[0].shape == (0,)
 
 
+@pytest.mark.parametrize("partner", ["circle", "arc", "cylinder"])
+def test_a_bore_with_a_depth_ignores_partners_behind_its_solid(partner):
+    # A concave patch of radius 1.1 over 0.5 .. 1.5 rad with depth 0.5 (fifth parameter): a
+    # ring or journal of radius 1.0 moved toward the patch so that it is 0.4 outside the
+    # radius is in the solid (a contact at gap -0.4), 0.6 outside it has gone round behind
+    # the solid (none, as the C4 hollow of c60-trip at 19.62 ms); without a depth (0) both are
+    # contacts. The gap is exact (clearance 0.1 minus the eccentricity): HAND.
+    toward = np.array([math.cos(1.0), math.sin(1.0), 0.0])
+    shape = {"circle": (G.CIRCLE, params(1.0)), "arc": (G.ARC, params(1.0, 0.0, 2.0)),
+             "cylinder": (G.CYLINDER, params(1.0, 0.2))}[partner]
+    for depth, expected in ((0.5, (1, 0)), (0.0, (1, 1))):
+        patch = (G.BORE, params(1.1, 0.5, 0.5, 1.5, depth), np.zeros(3), IDENTITY)
+        counts = []
+        for penetration in (0.4, 0.6):
+            gap = contacts(*shape, (0.1 + penetration) * toward, IDENTITY, *patch)[0]
+            counts.append(min(gap.shape[0], 1))
+            if gap.shape[0]:
+                assert np.all(np.abs(gap + penetration) < HAND)
+        assert tuple(counts) == expected
+
+
+def test_bore_depth_is_packed_and_validated():
+    from clearbench.scenarios.shapes import Bore
+    from clearbench.scenarios.validation import SceneError
+
+    assert G.pack_shape_parameters(Bore("b", radius=1.0, depth=0.25))[4] == 0.25
+    assert G.pack_shape_parameters(Bore("b", radius=1.0))[4] == 0.0  # no depth: unbounded
+    with pytest.raises((SceneError, ValueError), match="depth"):
+        Bore("b", radius=1.0, depth=0.0)
+
+
 @pytest.mark.parametrize("gap0", GAPS, ids=["separated", "touching", "penetrating"])
 def test_journal_in_bore_contacts_at_the_ends_of_the_overlap(gap0):
     # Bore radius 1.3 on |z| <= 1; journal radius 1.0 shifted along x so that the radial gap is

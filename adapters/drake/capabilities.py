@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from clearbench.adapters.base import Capability, Support
+from clearbench.adapters.base import BORE_DEPTH_NOTE, Capability, Support
 from clearbench.adapters.drake.settings import DrakeSettings
 from clearbench.adapters.drake.topology import Topology, plan_topology
 from clearbench.adapters.primitive_pieces import pair_clearance_growth, side_geometry
@@ -203,7 +203,7 @@ def shape_capability(context: FeatureContext, kind: str) -> Capability | None:
                        "collide too")
     if kind in ("circle", "arc", "bore"):
         how = (f"{settings.bore_pieces} Capsules per full circle along the axis (a Mesh would "
-               "be its convex hull for point contact)" if kind == "bore"
+               f"be its convex hull for point contact; {BORE_DEPTH_NOTE})" if kind == "bore"
                else f"{settings.ring_pieces} Spheres per full circle")
         return _approx(f"{how}: " + "; ".join(ring_summary(context.scene, settings)))
     return None

@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from clearbench.adapters.base import Capability, Support
+from clearbench.adapters.base import BORE_DEPTH_NOTE, Capability, Support
 from clearbench.adapters.exudyn.geometry import (
     UnsupportedPair,
     facet_error,
@@ -203,7 +203,7 @@ def shape_capability(context: FeatureContext, kind: str) -> Capability | None:
                        "otherwise a prism of facets: "
                        + "; ".join(shape_summary(scene, s, (Bore, Cylinder))))
     if kind == "bore":
-        return _approx("lining of facets (circumscribed polygon): "
+        return _approx(f"lining of facets (circumscribed polygon; {BORE_DEPTH_NOTE}): "
                        + "; ".join(shape_summary(scene, s, (Bore, Cylinder))))
     if kind == "capsule":
         return _unsupported("Exudyn has no capsule connector")

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from clearbench.adapters.base import Capability, Support
+from clearbench.adapters.base import BORE_DEPTH_NOTE, Capability, Support
 from clearbench.adapters.mujoco.geometry import (
     bore_piece_count,
     bore_radius_error,
@@ -309,7 +309,7 @@ def shape_capability(context: FeatureContext, kind: str) -> Capability | None:
             f"MuJoCo geoms are convex: {settings.bore_pieces} boxes per full circle line "
             "the hole, their inner faces the circumscribed polygon (apothem R), so the "
             "hole is up to R (1/cos(pi/N) - 1) larger at the corners; the boxes' end faces "
-            "collide too (beyond the bore's angles and length): "
+            f"collide too (beyond the bore's angles and length); {BORE_DEPTH_NOTE}: "
             + "; ".join(bore_summary(scene, settings)))
     if kind in ("circle", "arc"):
         return _approx(f"ring of {settings.ring_pieces} {settings.ring_piece}s per full "

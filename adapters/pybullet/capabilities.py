@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from clearbench.adapters.base import Capability, Support
+from clearbench.adapters.base import BORE_DEPTH_NOTE, Capability, Support
 from clearbench.adapters.pybullet.geometry import (
     collision_groups,
     collision_margin,
@@ -232,8 +232,9 @@ def shape_capability(context: FeatureContext, kind: str) -> Capability | None:
                        f"{settings.face_thickness:g} x its half extent): edges and sides "
                        "collide too")
     if kind in ("circle", "arc", "bore"):
-        how = (f"{settings.bore_pieces} capsules per full circle along the axis"
-               if kind == "bore" else f"{settings.ring_pieces} spheres per full circle")
+        how = (f"{settings.bore_pieces} capsules per full circle along the axis ("
+               f"{BORE_DEPTH_NOTE})" if kind == "bore"
+               else f"{settings.ring_pieces} spheres per full circle")
         return _approx(f"{how}, compounds of at most 16 children split across welded links "
                        "(PyBullet drops a compound's children beyond 16 silently; guarded): "
                        + "; ".join(ring_summary(context.scene, settings)))

@@ -108,13 +108,16 @@ C7 = "Mcontact_Fcontact_bot_1_C7"
 #: concave hollow below the side plane (r 5.9) and the convex fillet (r 0.05) between the planes.
 WEDGE_FACES = ("side", "top", "hollow", "fillet")
 Z_AXIS = (0.0, 0.0, 1.0)
-#: How far the solid behind a plane contact face reaches [mm] (``Rectangle.depth``): a partner
+#: How far the solid behind a plane contact face or a partial bore reaches [mm]
+#: (``Rectangle.depth``, ``Bore.depth``): a partner
 #: deeper than this has gone round behind the part, it is not in it. Without it the handle,
 #: which turns freely after a trip (the source has no OFF stop), brings its ON-stop face back
 #: round behind the case's stop pins 8.5 mm "deep" at 15.2 ms of c60-trip, and the projection
 #: tears the handle out of its bearing. 0.5 mm is 250x the deepest motion of a contact in one
 #: step (about 2 mm/ms x 1e-3 ms) and below the thickness of the C-60's plates and walls
-#: (about 1 mm; an estimate, not measured on the CAD).
+#: (about 1 mm; an estimate, not measured on the CAD). Likewise, after the trip the tripping
+#: bar's C4 partners leave the hook's concave hollow (a partial bore) round behind it, 13.4 mm
+#: "deep" at 19.62 ms of c60-trip, and the projection moved the parts 6.4 mm in one step.
 FACE_DEPTH = 0.5
 
 
@@ -286,8 +289,11 @@ def _shape(name: str, primitive: prim.Primitive, toward_world: np.ndarray, pose:
         orientation = _frame_quaternion(primitive.x_axis, axis)
         if bore:
             # A full bore keeps the exact default range (the document rounds 2 pi to 12 digits).
+            # A partial bore (the C4 hollow, a concave patch) can be left round behind its
+            # solid as a face can (FACE_DEPTH); a full bore cannot be left that way.
             angles = {} if primitive.is_full else dict(start_angle=primitive.start_angle,
-                                                       end_angle=primitive.end_angle)
+                                                       end_angle=primitive.end_angle,
+                                                       depth=FACE_DEPTH)
             return Bore(name, position=tuple(centre), orientation=orientation,
                         radius=primitive.radius, half_length=0.5 * primitive.length, **angles)
         return Cylinder(name, position=tuple(centre), orientation=orientation,

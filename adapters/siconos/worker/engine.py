@@ -169,14 +169,15 @@ def _packed_parameters(shape):
     if kind == "arc":
         return [shape.get("radius", 0.1), shape.get("start_angle", 0.0),
                 shape.get("end_angle", math.pi)]
-    # An absent face depth (None) is 0 in the packed form: no bound.
+    # An absent face or bore depth (None) is 0 in the packed form: no bound.
     if kind == "rectangle":
         return list(shape.get("half_extents", (0.5, 0.5))) + [shape.get("depth") or 0.0]
     if kind == "disc":
         return [shape.get("radius", 0.5), shape.get("depth") or 0.0]
     if kind == "bore":
         return [shape.get("radius", 0.1), shape.get("half_length", 0.5),
-                shape.get("start_angle", 0.0), shape.get("end_angle", 2.0 * math.pi)]
+                shape.get("start_angle", 0.0), shape.get("end_angle", 2.0 * math.pi),
+                shape.get("depth") or 0.0]
     raise ValueError(f"unknown shape kind {kind!r}")
 
 
