@@ -22,7 +22,7 @@ lint: $(STAMP)
 	$(PY) -m ruff check .
 
 test: $(STAMP) lint siconos chromium
-	$(PY) -m pytest -m "not slow" --durations=30
+	$(PY) -m pytest -m "not slow" -n auto --dist worksteal --durations=30
 
 # The quick regression suite against the committed baselines (CI runs it after the tests).
 regress: $(STAMP)
