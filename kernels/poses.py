@@ -12,7 +12,7 @@ import numpy as np
 
 from clearbench.kernels.quaternion import quat_normalize, quat_to_matrix
 
-__all__ = ["centre_of_mass_frames"]
+__all__ = ["centre_of_mass_frames", "shifted_velocities"]
 
 
 def centre_of_mass_frames(positions, orientations, centres_of_mass
@@ -43,3 +43,14 @@ def centre_of_mass_frames(positions, orientations, centres_of_mass
     rotation = np.array([quat_to_matrix(q) for q in p])
     x = np.array([positions[i] + rotation[i] @ centres_of_mass[i] for i in range(len(p))])
     return x, p, rotation
+
+
+def shifted_velocities(velocity: np.ndarray, omega: np.ndarray, offset: np.ndarray
+                       ) -> np.ndarray:
+    """Velocities (n, 3) of the points ``offset`` (n, 3) away from points moving at
+    ``velocity`` (n, 3) on rigid bodies turning at ``omega`` (n, 3), all world axes:
+    ``velocity + omega x offset`` row by row. Written out: ``np.cross`` spends about 25 us per
+    call on its arguments, and the adapters call this once per recorded step."""
+    return velocity + (omega[:, [1, 2, 0]] * offset[:, [2, 0, 1]]
+                       - omega[:, [2, 0, 1]] * offset[:, [1, 2, 0]])
+

@@ -18,12 +18,14 @@ from clearbench.adapters.energy_guard import EnergyGuard
 from clearbench.adapters.mujoco.settings import MujocoSettings
 from clearbench.adapters.step_monitor import StepMonitor
 from clearbench.adapters.trajectory import RunStatus
+from clearbench.kernels.poses import shifted_velocities
 from clearbench.kernels.time_profiles import evaluate_profile_slope
 from clearbench.scenarios.energy import mechanical_energy
 from clearbench.scenarios.loads import LinearSpringDamper, Moment, PointForce, TorsionalSpringDamper
 from clearbench.scenarios.scene import Scene
 
 logger = logging.getLogger(__name__)
+
 
 
 class Runner:
@@ -105,16 +107,17 @@ class Runner:
         rotation = d.xmat[ids].reshape(-1, 3, 3)
         omega = d.cvel[ids, :3]
         offset = d.xipos[ids] - d.subtree_com[self.model.body_rootid[ids]]
-        velocity = d.cvel[ids, 3:] + np.cross(omega, offset)
-        omega_body = np.einsum("bji,bj->bi", rotation, omega)
+        velocity = shifted_velocities(d.cvel[ids, 3:], omega, offset)
+        omega_body = (rotation * omega[:, :, None]).sum(axis=1)    # R^T omega per body
         return d.xpos[ids].copy(), d.xquat[ids].copy(), velocity, omega_body
 
-    def energy(self) -> tuple[float, float]:
-        """(total, kinetic) mechanical energy of the current state
+    def energy(self, state=None) -> tuple[float, float]:
+        """(total, kinetic) mechanical energy of the current state, or of ``state`` (the
+        :meth:`body_state` of the current configuration, when already read)
         (:func:`~clearbench.scenarios.energy.mechanical_energy`: kinetic, gravity, linear and
         torsional springs; internal units)."""
         d, ids = self.data, self.ids
-        _, _, velocity, omega = self.body_state()
+        _, _, velocity, omega = self.body_state() if state is None else state
         sites = dict(zip((load.name for load in self._springs), self._site_ids, strict=True))
 
         def spring_points(load):
@@ -206,8 +209,8 @@ class Runner:
             # Kinematics refreshed before reading the state (mj_step leaves them one step
             # old); the contact forces, read at storing, are not touched by the refresh.
             problem = monitor.after_step(
-                k, data.time, self._refreshed_state, lambda state: self.energy(),
-                lambda state: self.store(self.contact_forces()), problem=problem)
+                k, data.time, self._refreshed_state, self.energy,
+                lambda state: self.store(self.contact_forces(), state), problem=problem)
             if problem is not None:
                 logger.info("%s: stopped: %s", self.scene.name, problem)
                 return RunStatus.DIVERGED, problem
@@ -256,10 +259,11 @@ class Runner:
                 worst = max(worst, float(stat.gradient))
         return worst
 
-    def store(self, forces: tuple | None = None) -> None:
-        """Record the current state as the next sample; with ``forces`` (from
-        :meth:`contact_forces`), the step's solver statistics and own residual too."""
-        position, orientation, velocity, omega = self.body_state()
+    def store(self, forces: tuple | None = None, state=None) -> None:
+        """Record the current state (its :meth:`body_state`, or ``state`` when already read)
+        as the next sample; with ``forces`` (from :meth:`contact_forces`), the step's solver
+        statistics and own residual too."""
+        position, orientation, velocity, omega = self.body_state() if state is None else state
         residual = self.solver_residual() if forces is not None else None
         self.monitor.recorder.store(self.data.time, position, orientation, velocity, omega,
                                     contacts=forces, residual=residual)
