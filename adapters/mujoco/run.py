@@ -27,7 +27,6 @@ from clearbench.scenarios.scene import Scene
 logger = logging.getLogger(__name__)
 
 
-
 class Runner:
     """The step loop of one run: drivers, loads, guards, and sampling into arrays."""
 
@@ -108,7 +107,7 @@ class Runner:
         omega = d.cvel[ids, :3]
         offset = d.xipos[ids] - d.subtree_com[self.model.body_rootid[ids]]
         velocity = shifted_velocities(d.cvel[ids, 3:], omega, offset)
-        omega_body = (rotation * omega[:, :, None]).sum(axis=1)    # R^T omega per body
+        omega_body = np.einsum("bji,bj->bi", rotation, omega)
         return d.xpos[ids].copy(), d.xquat[ids].copy(), velocity, omega_body
 
     def energy(self, state=None) -> tuple[float, float]:
