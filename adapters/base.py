@@ -43,7 +43,7 @@ from clearbench.adapters.trajectory import RunStatus, Trajectory
 from clearbench.scenarios.features import FeatureKind, parse_feature
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.units import SI
-from clearbench.scenarios.validation import TIME
+from clearbench.scenarios.validation import LENGTH, TIME
 
 
 class Support(enum.Enum):
@@ -348,12 +348,16 @@ class SteppingEngine(ModuleEngine):
         finally:
             self.release(built)
         monitor = runner.monitor
+        to_scene = internal.units.factor_to(scene.units, LENGTH)
+        overlap = {name: depth * to_scene
+                   for name, depth in self.rebuild_overlap(built).items() if depth > 0.0}
         return monitor.recorder.trajectory(
             scene, dt, recorded_units=internal.units, engine=self.name, preset=self.preset,
             build_seconds=build_seconds, stepping_seconds=monitor.stepping_seconds,
             steps=self.steps_taken(runner, steps, dt), status=status, message=message,
             internal_units=internal.units.describe(), **monitor.statistics(),
-            metadata=self.metadata(scene, internal, config, built, runner))
+            rebuild_overlap=overlap, metadata=self.metadata(scene, internal, config, built,
+                                                           runner))
 
     # ------------------------------------------------------------------ hooks
     def internal_scene(self, scene: Scene, config) -> Scene:
@@ -375,6 +379,12 @@ class SteppingEngine(ModuleEngine):
     @abstractmethod
     def metadata(self, scene: Scene, internal: Scene, config, built, runner) -> dict:
         """The engine's notes of the run (settings, guards, solver statistics, ...)."""
+
+    def rebuild_overlap(self, built) -> Mapping[str, float]:
+        """Per contact pair name, how deep the exact surfaces can overlap while the model's
+        rebuilt shapes only touch [internal length] (:attr:`Trajectory.rebuild_overlap`;
+        default: every pair exact)."""
+        return {}
 
     def step(self, runner) -> tuple[RunStatus, str]:
         """Run the loop; (status, message) of its end."""

@@ -185,6 +185,20 @@ def ring_chord_error(radius: float, step: float) -> float:
     return radius * (1.0 - math.cos(0.5 * step))
 
 
+def polygon_corner_error(radius: float, step: float) -> float:
+    """How far the corners of the polygon circumscribed about a circle of ``radius`` (one
+    side per ``step`` of angle [rad]) stand outside the circle [L]: R (1/cos(step/2) - 1)."""
+    return radius * (1.0 / math.cos(0.5 * step) - 1.0)
+
+
+def pair_overlap(sides) -> float:
+    """How deep the scene's exact surfaces of one pair can overlap while the pieces of its two
+    sides (:class:`SideGeometry`) only touch [L]: the sum of the sides' ``shape_error`` (the
+    sag a flat partner sinks between two pieces of a ring or a bore's lining; 0 where exact).
+    Against a curved partner the overlap is smaller: this is its upper bound."""
+    return float(sum(side.shape_error for side in sides))
+
+
 def journal_clearance_growth(ring_radius: float, journal_radius: float, sphere_radius: float,
                              centre_radius: float, step: float) -> float:
     """Extra eccentricity a coaxial journal gains between two ring spheres [L].

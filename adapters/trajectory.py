@@ -74,6 +74,11 @@ class Trajectory:
         Wall time inside the contact solver [s] (NaN where the engine does not say).
     internal_units : str
         The units the engine ran in, and whether the results were converted back.
+    rebuild_overlap : dict
+        Per contact pair name, how deep the scene's exact surfaces can overlap while the
+        engine's rebuilt shapes only touch [L]: the sag of a ring of spheres or of a bore's
+        polygon lining (upper bound, a flat partner's); pairs the engine models exactly are
+        absent. The harness counts penetration with and without it.
     metadata : dict
         The engine's own notes of the run (settings, guards, statistics only it has).
     """
@@ -109,11 +114,12 @@ class Trajectory:
     energy_max_gain: float = float("nan")
     solver_seconds: float = float("nan")
     internal_units: str = ""
+    rebuild_overlap: dict = field(default_factory=dict)
     metadata: dict = field(default_factory=dict)
 
     #: The run statistics every engine fills (the harness reads them by attribute).
     STATISTICS = ("engine_version", "rigid_contacts", "unconverged_steps", "unconverged_count",
-                  "energy_max_gain", "solver_seconds", "internal_units")
+                  "energy_max_gain", "solver_seconds", "internal_units", "rebuild_overlap")
 
     ARRAYS = ("times", "positions", "orientations", "velocities", "angular_velocities",
               "contact_normal_force", "contact_force", "solver_iterations", "solver_residual",

@@ -60,7 +60,7 @@ from pydrake.systems.framework import DiagramBuilder
 from clearbench.adapters.drake.settings import DrakeSettings
 from clearbench.adapters.drake.topology import Topology, plan_topology
 from clearbench.adapters.force_elements import ForceElements, scene_force_elements
-from clearbench.adapters.primitive_pieces import Piece, side_geometry
+from clearbench.adapters.primitive_pieces import Piece, pair_overlap, side_geometry
 from clearbench.kernels.quaternion import quat_normalize, quat_to_matrix
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.scales import largest_length
@@ -99,6 +99,7 @@ class BuiltPlant:
     driven: list
     materials: list
     notes: dict = field(default_factory=dict)
+    rebuild_overlap: dict = field(default_factory=dict)  # contact name -> [L] (pair_overlap)
 
 
 def _unit(q) -> np.ndarray:
@@ -423,7 +424,9 @@ def build_plant(scene: Scene, settings: DrakeSettings, dt: float) -> BuiltPlant:
     _set_initial_state(scene, plant, plant_context, bodies, topology, joints)
     loads = scene_force_elements(scene)
     return BuiltPlant(scene, settings, dt, diagram, plant, simulator, context, plant_context,
-                      bodies, topology, geometry_pair, loads, driven, materials, notes)
+                      bodies, topology, geometry_pair, loads, driven, materials, notes,
+                      {contact.name: pair_overlap(geometries) for contact, geometries
+                       in zip(scene.all_contacts, pair_geometries, strict=True)})
 
 
 def _filter_to_pairs(plant, builder, sides_of_pair, all_ids) -> None:

@@ -69,6 +69,9 @@ class ExudynEngine(SteppingEngine):
         # Exudyn reduces its step on its own: the steps of dt the recorded time covers.
         return min(steps, int(round(_last_time(runner) / dt)))
 
+    def rebuild_overlap(self, built) -> dict:
+        return {plan.contact.name: plan.overlap for plan in built.pair_plans}
+
     def metadata(self, scene: Scene, internal: Scene, config: ExudynSettings, built,
                  runner: Runner) -> dict:
         last_time = _last_time(runner)

@@ -52,6 +52,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from clearbench.adapters.exudyn.settings import ExudynSettings
+from clearbench.adapters.primitive_pieces import polygon_corner_error
+from clearbench.adapters.primitive_pieces import ring_chord_error as chord_sag
 from clearbench.kernels.quaternion import quat_to_matrix
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.contacts import ContactPair
@@ -109,6 +111,10 @@ class PairPlan:
     connectors: list[ConnectorPlan] = field(default_factory=list)
     how: str = ""
     shape_error: float = 0.0  # largest surface error of the rebuild [L]
+    #: How deep the scene's exact surfaces can overlap while the connectors only touch [L]:
+    #: the sag between ring spheres, the corners of a bore's facet lining; 0 where the rebuild
+    #: errs outward only (a journal's circumscribed prism) or is exact.
+    overlap: float = 0.0
 
 
 class UnsupportedPair(ValueError):
@@ -163,13 +169,13 @@ def ring_points(shape: Circle | Arc, settings: ExudynSettings) -> np.ndarray:
 def ring_chord_error(radius: float, spheres_per_circle: int) -> float:
     """Largest distance between a ring and the chord of two neighbouring samples [L]:
     R (1 - cos(pi / N)); a partner spanning two samples sees the ring that much lower."""
-    return radius * (1.0 - math.cos(math.pi / spheres_per_circle))
+    return chord_sag(radius, 2.0 * math.pi / spheres_per_circle)
 
 
 def facet_error(radius: float, facets_per_circle: int) -> float:
     """Largest distance between a circle and its circumscribed polygon [L]:
     R (1 / cos(pi / M) - 1), at the polygon's corners."""
-    return radius * (1.0 / math.cos(math.pi / facets_per_circle) - 1.0)
+    return polygon_corner_error(radius, 2.0 * math.pi / facets_per_circle)
 
 
 def ring_sphere_radius(shape, partner_room: float, settings: ExudynSettings) -> float:
@@ -335,7 +341,7 @@ def _ring_face(scene, contact, ring_side, face_side, settings) -> PairPlan:
                                                     triangles, edges),
                     f"{len(centres)} spheres (radius {rho:.3g}) on the {ring.kind} against "
                     f"{how} moved back by the radius")
-    plan.shape_error = ring_chord_error(ring.radius, settings.ring_spheres)
+    plan.shape_error = plan.overlap = ring_chord_error(ring.radius, settings.ring_spheres)
     return plan
 
 
@@ -395,7 +401,7 @@ def _in_plane(scene, contact, ring_side, partner_side, settings, hollow: bool) -
     plan = PairPlan(contact, connectors,
                     f"{len(connectors)} spheres (radius {rho:.3g}) on the {ring.kind}, each "
                     f"{what} on the axis at its level (exact for motion normal to the axis)")
-    plan.shape_error = ring_chord_error(ring.radius, settings.ring_spheres)
+    plan.shape_error = plan.overlap = ring_chord_error(ring.radius, settings.ring_spheres)
     return plan
 
 
@@ -445,8 +451,8 @@ def _ring_cylinder(scene, contact, ring_side, cylinder_side, settings) -> PairPl
                     f"cylinder as a prism of {settings.journal_facets} facets per circle "
                     f"(within {math.degrees(settings.facet_window):.0f} deg of each sphere), "
                     + ("internal" if internal else "external"))
-    plan.shape_error = (facet_error(apothem + rho, settings.journal_facets)
-                        + ring_chord_error(ring.radius, settings.ring_spheres))
+    plan.overlap = ring_chord_error(ring.radius, settings.ring_spheres)
+    plan.shape_error = facet_error(apothem + rho, settings.journal_facets) + plan.overlap
     return plan
 
 
@@ -480,7 +486,7 @@ def _ring_bore(scene, contact, ring_side, bore_side, settings) -> PairPlan:
     plan = PairPlan(contact, connectors,
                     f"{len(centres)} spheres (radius {rho:.3g}) on the {ring.kind} against the "
                     f"bore's lining of {settings.journal_facets} facets per circle")
-    plan.shape_error = facet_error(bore.radius, settings.journal_facets)
+    plan.shape_error = plan.overlap = facet_error(bore.radius, settings.journal_facets)
     return plan
 
 
@@ -497,7 +503,7 @@ def _cylinder_bore(scene, contact, cylinder_side, bore_side, settings) -> PairPl
     plan = PairPlan(contact, connectors,
                     f"{len(centres)} spheres of the journal's radius along its axis against "
                     f"the bore's lining of {settings.journal_facets} facets per circle")
-    plan.shape_error = facet_error(bore.radius, settings.journal_facets)
+    plan.shape_error = plan.overlap = facet_error(bore.radius, settings.journal_facets)
     return plan
 
 

@@ -19,6 +19,7 @@ from clearbench.adapters.mujoco.geometry import (
     GeomSpec,
     PairSpec,
     RingInfo,
+    pair_overlaps,
     shape_geoms,
 )
 from clearbench.adapters.mujoco.laws import LawForces, law_forces
@@ -101,6 +102,7 @@ class BuiltModel:
     warnings: list[str] = field(default_factory=list)
     initial_velocity_residual: float = 0.0
     law_forces: LawForces | None = None  # angle / distance law loads, applied every step
+    rebuild_overlap: dict = field(default_factory=dict)  # contact name -> [L] (pair_overlaps)
 
 
 def _relative_pose(parent_pose, child_pose) -> tuple[np.ndarray, np.ndarray]:
@@ -227,7 +229,8 @@ def build_model(scene: Scene, settings: MujocoSettings, time_step: float) -> Bui
                      for load, body, sign in hinge_springs]
     built = BuiltModel(model, data, topology, body_ids, pair_lookup, contact_body_b, driven,
                        python_loads, rings, parameters, hinge_springs, warnings,
-                       law_forces=law_forces(scene, model))
+                       law_forces=law_forces(scene, model),
+                       rebuild_overlap=pair_overlaps(scene, rings))
     if built.law_forces is not None:
         built.law_forces.wrenches(data)  # compile / load the numba function outside stepping
     # Preloads are constant motor controls: set after the reset of the initial state.

@@ -36,6 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from clearbench.adapters.mujoco.settings import MujocoSettings, ring_chord_error
+from clearbench.adapters.primitive_pieces import polygon_corner_error
 from clearbench.kernels.quaternion import quat_from_matrix, quat_normalize, quat_to_matrix
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.scene import Scene
@@ -79,7 +80,10 @@ class GeomSpec:
 @dataclass(frozen=True)
 class RingInfo:
     """How a circle/arc shape was rebuilt: pieces, piece radius and chord error [L]; for a
-    bore: boxes, their radial half thickness and the polygon's radius error [L]."""
+    bore: boxes, their radial half thickness and the polygon's radius error [L]. ``overlap``:
+    how deep a partner's exact surface can reach into the shape while it only touches the
+    pieces [L] (spheres: the chord sag; a bore's boxes: their corners; 0 for the circumscribed
+    polygon of capsules or boxes round a ring, which errs outward)."""
 
     body: str
     shape: str
@@ -87,6 +91,7 @@ class RingInfo:
     pieces: int
     piece_radius: float
     chord_error: float
+    overlap: float = 0.0
 
 
 def ring_piece_radius(scene: Scene, body: str, shape: Shape, settings: MujocoSettings) -> float:
@@ -179,7 +184,8 @@ def _ring_geoms(scene: Scene, body_name: str, shape: Circle | Arc, settings: Muj
                             plane_compensation=rho))
     full_circle_pieces = round(2.0 * math.pi / step)
     chord = ring_chord_error(shape.radius, full_circle_pieces, settings.ring_piece)
-    return out, RingInfo(body_name, shape.name, shape.radius, len(out), rho, chord)
+    return out, RingInfo(body_name, shape.name, shape.radius, len(out), rho, chord,
+                         chord if settings.ring_piece == "sphere" else 0.0)
 
 
 def face_thickness(shape: Rectangle | Disc, settings: MujocoSettings) -> float:
@@ -202,7 +208,7 @@ def bore_radius_error(shape: Bore, settings: MujocoSettings) -> float:
     are tangent to the circle (apothem R), the corners stand R (1/cos(step/2) - 1) outside it,
     step the angle one box spans (at most 2 pi / bore_pieces)."""
     step = (shape.end_angle - shape.start_angle) / bore_piece_count(shape, settings)
-    return shape.radius * (1.0 / math.cos(0.5 * step) - 1.0)
+    return polygon_corner_error(shape.radius, step)
 
 
 def _bore_geoms(body_name: str, shape: Bore, settings: MujocoSettings, geom, position,
@@ -228,8 +234,17 @@ def _bore_geoms(body_name: str, shape: Bore, settings: MujocoSettings, geom, pos
         centre = position + rotation @ ((shape.radius + wall) * radial)
         out.append(geom("box", (wall, shape.half_length, half_chord), name=f"{prefix}#{k}",
                         pos=centre, quat=quat_from_matrix(rotation @ local)))
-    return out, RingInfo(body_name, shape.name, shape.radius, pieces, wall,
-                         bore_radius_error(shape, settings))
+    error = bore_radius_error(shape, settings)
+    return out, RingInfo(body_name, shape.name, shape.radius, pieces, wall, error, error)
+
+
+def pair_overlaps(scene: Scene, rings) -> dict[str, float]:
+    """Per contact pair of ``scene`` (expanded), the sum of its two sides' ring
+    ``overlap`` [L] (:class:`RingInfo`; a side without a ring is exact)."""
+    overlap = {(ring.body, ring.shape): ring.overlap for ring in rings}
+    return {contact.name: overlap.get((contact.body_a, contact.shape_a), 0.0)
+            + overlap.get((contact.body_b, contact.shape_b), 0.0)
+            for contact in scene.expanded.contacts}
 
 
 @dataclass(frozen=True)

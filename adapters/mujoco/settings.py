@@ -20,6 +20,7 @@ import dataclasses
 import math
 from dataclasses import dataclass
 
+from clearbench.adapters import primitive_pieces
 from clearbench.adapters.options import OptionTable, boolean, choice, integer, number, numbers
 
 #: MuJoCo's own defaults (mjOption and the default geom solref/solimp of MuJoCo 3/4).
@@ -364,10 +365,10 @@ def ring_chord_error(radius: float, pieces_per_circle: int, piece: str = "sphere
     and a partner spanning two of them meets their chord, R (1 - cos(pi/N)) inside;
     capsules/boxes form the circumscribed polygon, whose corners are R (1/cos(pi/N) - 1)
     outside."""
-    half_angle = math.pi / pieces_per_circle
+    step = 2.0 * math.pi / pieces_per_circle
     if piece == "sphere":
-        return radius * (1.0 - math.cos(half_angle))
-    return radius * (1.0 / math.cos(half_angle) - 1.0)
+        return primitive_pieces.ring_chord_error(radius, step)
+    return primitive_pieces.polygon_corner_error(radius, step)
 
 
 def ring_clearance_error(bore_radius: float, radial_clearance: float, pieces_per_circle: int,

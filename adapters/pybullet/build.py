@@ -27,6 +27,7 @@ import math
 import numpy as np
 
 from clearbench.adapters.force_elements import scene_force_elements
+from clearbench.adapters.primitive_pieces import pair_overlap
 from clearbench.adapters.pybullet.dynamics import (
     body_dynamics,
     check_mass_properties,
@@ -80,6 +81,8 @@ def build_world(scene: Scene, settings: PybulletSettings, time_step: float) -> B
             notes[(contact.name, side)] = geometry.note
             objects_per_body[geometry.body] = objects_per_body.get(geometry.body, 0) + len(groups)
         sides.append(pair_sides)
+    overlap = {contact.name: pair_overlap(geometry for geometry, _ in pair_sides)
+               for contact, pair_sides in zip(expanded.contacts, sides, strict=True)}
     topology = plan_topology(scene, settings.body_model, objects_per_body)
     if topology.problems:
         reasons = "; ".join(f"{feature}: {why}" for feature, why in topology.problems)
@@ -87,10 +90,12 @@ def build_world(scene: Scene, settings: PybulletSettings, time_step: float) -> B
 
     client = pb.connect(pb.DIRECT)
     try:
-        return _build(client, scene, settings, time_step, topology, sides, notes)
+        built = _build(client, scene, settings, time_step, topology, sides, notes)
     except Exception:
         pb.disconnect(client)
         raise
+    built.rebuild_overlap = overlap
+    return built
 
 
 def disconnect(built: BuiltWorld) -> None:

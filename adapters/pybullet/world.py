@@ -76,6 +76,7 @@ class BuiltWorld:
     warnings: list = field(default_factory=list)
     initial_velocity_residual: float = 0.0
     side_notes: dict = field(default_factory=dict)
+    rebuild_overlap: dict = field(default_factory=dict)  # contact name -> [L] (pair_overlap)
     holders: list = field(default_factory=list)   # static bodies holding link shapes' margins
 
 

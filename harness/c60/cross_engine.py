@@ -47,7 +47,10 @@ class C60RunFigures:
     settled window.
     ``strike``, ``release``, ``opening``: trip events [ms] (:func:`.analysis.trip_events`),
     c60-trip only (NaN where the event did not happen in the run).
-    ``penetration_max`` [mm] and the contact pair where it is largest; ``clearance_excess``:
+    ``penetration_max`` [mm] and the contact pair where it is largest;
+    ``penetration_beyond_rebuild`` [mm]: the largest penetration less its pair's rebuild
+    overlap (:func:`~clearbench.harness.measure.series.penetration_beyond_rebuild`: the sag of
+    an engine's ring of spheres is its approximation, not penetration); ``clearance_excess``:
     per joint of the mechanism (J1..J7 and the needle bearing S3), the largest penetration of
     its ring pairs [mm], which is the journal's eccentricity beyond its radial clearance (the
     rings are contacts offset by the clearance, see :mod:`clearbench.scenarios.c60.model`).
@@ -74,6 +77,7 @@ class C60RunFigures:
     opening: float = math.nan
     penetration_max: float = math.nan
     penetration_pair: str = ""
+    penetration_beyond_rebuild: float = math.nan
     clearance_excess: dict = field(default_factory=dict)
     stepping_seconds: float = math.nan
     stepping_seconds_per_step: float = math.nan
@@ -129,6 +133,8 @@ def trajectory_figures(scene: Scene, trajectory: Trajectory) -> dict:
         out["penetration_max"] = float(depth[worst])
         out["penetration_pair"] = scene.expanded.contacts[worst[1]].name \
             if len(scene.expanded.contacts) == depth.shape[1] else ""
+        out["penetration_beyond_rebuild"] = float(np.max(
+            metrics.penetration_beyond_rebuild(scene, trajectory, depth)))
         out["clearance_excess"] = joint_excess(scene, depth)
     problems = []
     if scene.name == ON_SCENE:

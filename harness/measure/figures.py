@@ -8,6 +8,10 @@ scene is absent.
 
 =======================================  =====================================================
 ``penetration_max``                      max over pairs and samples of max(0, -gap) [L]
+``penetration_beyond_rebuild_max``       the same less each pair's rebuild overlap (how deep
+                                         the exact surfaces can overlap while the engine's
+                                         rebuilt shapes only touch, a ring of spheres' sag;
+                                         ``Trajectory.rebuild_overlap``) [L]
 ``penetration_relative``                 the same over the smallest feature of its pair [-]
 ``penetration_swept_max``                largest penetration on the straight path between two
                                          recorded samples (swept test, series.py) [L]
@@ -256,6 +260,8 @@ def _drift(scene, trajectory, out: _Collector, reasons: list[str]) -> None:
     if contacts:
         depth = metrics.penetration(scene, trajectory)
         out.put("penetration_max", np.max(depth))
+        out.put("penetration_beyond_rebuild_max",
+                np.max(metrics.penetration_beyond_rebuild(scene, trajectory, depth)))
         feature = contact_feature_sizes(scene)
         relative = np.max(depth, axis=0) / feature
         out.put("penetration_relative", np.max(relative))

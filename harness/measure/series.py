@@ -188,6 +188,25 @@ def penetration(scene: Scene, trajectory: Trajectory) -> np.ndarray:
     return np.maximum(0.0, -np.where(np.isfinite(gaps), gaps, 0.0))
 
 
+def rebuild_overlaps(scene: Scene, trajectory: Trajectory) -> np.ndarray:
+    """(npair,) how deep each pair's exact surfaces can overlap while the engine's rebuilt
+    shapes only touch [L] (:attr:`Trajectory.rebuild_overlap`; 0 for a pair it models
+    exactly)."""
+    declared = trajectory.rebuild_overlap
+    return np.array([float(declared.get(contact.name, 0.0))
+                     for contact in scene.expanded.contacts])
+
+
+def penetration_beyond_rebuild(scene: Scene, trajectory: Trajectory,
+                               depth: np.ndarray | None = None) -> np.ndarray:
+    """Penetration beyond the engine's rebuild overlap, max(0, depth - overlap) of each pair,
+    (T, npair) [L]: the part of :func:`penetration` that the engine's approximation of the
+    shapes (a ring of spheres, a bore's polygon lining) cannot explain. ``depth``: the
+    penetration when already computed."""
+    depth = penetration(scene, trajectory) if depth is None else depth
+    return np.maximum(0.0, depth - rebuild_overlaps(scene, trajectory)[None, :])
+
+
 @dataclass(frozen=True)
 class ClearanceMotion:
     """Per clearance joint (T, nj): eccentricity of the journal in its bore at each bearing

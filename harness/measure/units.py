@@ -63,7 +63,8 @@ RAD, COUNT, PURE = FigureUnit(word="rad"), FigureUnit(word="count"), FigureUnit(
 
 #: Run figures (harness/measure/figures.py) -> unit.
 RUN_FIGURES: dict[str, FigureUnit] = {
-    "penetration_max": L, "penetration_relative": _of("the pair's smallest feature"),
+    "penetration_max": L, "penetration_beyond_rebuild_max": L,
+    "penetration_relative": _of("the pair's smallest feature"),
     "penetration_swept_max": L, "clearance_eccentricity_max": L, "clearance_excess_max": L,
     "clearance_excess_relative": _of("the radial clearance"), "joint_distance_max": L,
     "joint_angle_max": RAD, "driver_offset_max": L, "driver_angle_offset_max": RAD,

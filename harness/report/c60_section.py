@@ -124,12 +124,14 @@ def _head_cells(run: C60RunFigures) -> list[str]:
 
 
 def _tail_cells(run: C60RunFigures) -> list[str]:
-    """Largest penetration, worst joint, wall per step [ms] and per run [s], x reference."""
+    """Largest penetration, the same beyond the rebuild's overlap, worst joint, wall per step
+    [ms] and per run [s], x reference."""
     if run.status == "unsupported":
-        return ["—"] * 5
+        return ["—"] * 6
     return [f"{format_value(run.penetration_max)} {run.penetration_pair}".strip(),
-            _joints(run)[0], format_value(1e3 * run.stepping_seconds_per_step),
-            format_value(run.stepping_seconds), format_value(run.ratio_to_reference)]
+            format_value(run.penetration_beyond_rebuild), _joints(run)[0],
+            format_value(1e3 * run.stepping_seconds_per_step), format_value(run.stepping_seconds),
+            format_value(run.ratio_to_reference)]
 
 
 def on_rows(runs) -> list[list[str]]:
@@ -157,12 +159,12 @@ def trip_rows(runs) -> list[list[str]]:
 
 ON_HEAD = ["engine", "dt [ms]", "horizon [ms]", "status", "FC-1 [N] (vs reference)",
            "FC-2..FC-6 [mm]", "latch (hook creep after 3 ms) [mm]", "largest penetration [mm]",
-           "worst joint: clearance excess [mm]", "wall / step [ms]", "wall / run [s]",
-           "x reference"]
+           "beyond the rebuild's overlap [mm]", "worst joint: clearance excess [mm]",
+           "wall / step [ms]", "wall / run [s]", "x reference"]
 TRIP_HEAD = ["engine", "dt [ms]", "horizon [ms]", "status", "strike [ms]", "latch release [ms]",
              "contacts open [ms] (vs reference)", "largest penetration [mm]",
-             "worst joint: clearance excess [mm]", "wall / step [ms]", "wall / run [s]",
-             "x reference"]
+             "beyond the rebuild's overlap [mm]", "worst joint: clearance excess [mm]",
+             "wall / step [ms]", "wall / run [s]", "x reference"]
 
 
 def target_lines(section: C60Section) -> list[str]:
@@ -207,9 +209,13 @@ INTRO = ("Each engine and preset on the C-60 scenes, measured by the same code "
          "measurement pairs, each the mean over the last 1 ms (left out when a run ended "
          "before 3 ms); the latch holds when the hook moves less than the scene's "
          "stays_latched bound (1e-4 of the hook's size) after 3 ms; a joint's clearance excess "
-         "is the largest penetration of its rings. Wall times are stepping alone on a shared "
-         "machine; 'x reference' is the ratio of wall time per simulated ms to the reference "
-         "engine's fine run (its finest step), the run every error is measured against.")
+         "is the largest penetration of its rings. 'Beyond the rebuild's overlap' is the "
+         "largest penetration less what the engine's rebuilt shapes let the exact ones overlap "
+         "while they only touch (the sag of a ring of spheres, of a bore's polygon lining): "
+         "the part of the penetration the approximation cannot explain. Wall times are "
+         "stepping alone on a shared machine; 'x reference' is the ratio of wall time per "
+         "simulated ms to the reference engine's fine run (its finest step), the run every "
+         "error is measured against.")
 
 
 # ---------------------------------------------------------------------------- HTML
