@@ -21,7 +21,11 @@ demo: $(STAMP)
 lint: $(STAMP)
 	$(PY) -m ruff check .
 
+# numba's cache is filled once first, in one process (`clearbench compile --jobs 1`: two
+# processes compile the same kernels side by side); otherwise every pytest worker and
+# every run subprocess of the tests compiles the same kernels cold (minutes of CPU each).
 test: $(STAMP) lint siconos chromium
+	$(VENV)/bin/clearbench compile --jobs 1
 	$(PY) -m pytest -m "not slow" -n auto --dist worksteal --durations=30
 
 # The quick regression suite against the committed baselines (CI runs it after the tests).
