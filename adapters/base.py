@@ -383,8 +383,8 @@ class SteppingEngine(ModuleEngine):
     def rebuild_overlap(self, built) -> Mapping[str, float]:
         """Per contact pair name, how deep the exact surfaces can overlap while the model's
         rebuilt shapes only touch [internal length] (:attr:`Trajectory.rebuild_overlap`;
-        default: every pair exact)."""
-        return {}
+        default: the built model's ``rebuild_overlap`` mapping, or every pair exact)."""
+        return getattr(built, "rebuild_overlap", {})
 
     def step(self, runner) -> tuple[RunStatus, str]:
         """Run the loop; (status, message) of its end."""

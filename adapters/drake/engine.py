@@ -65,9 +65,6 @@ class DrakeEngine(SteppingEngine):
 
         return Runner(built, steps, record_every)
 
-    def rebuild_overlap(self, built) -> dict:
-        return built.rebuild_overlap
-
     def metadata(self, scene: Scene, internal: Scene, config: DrakeSettings, built,
                  runner) -> dict:
         to_internal = scene.units.factor_to(internal.units, TIME)

@@ -81,9 +81,6 @@ class MujocoEngine(SteppingEngine):
     def step(self, runner: Runner) -> tuple[RunStatus, str]:
         return _with_logged_warnings(runner)
 
-    def rebuild_overlap(self, built) -> dict:
-        return built.rebuild_overlap
-
     def metadata(self, scene: Scene, internal: Scene, config: MujocoSettings, built,
                  runner: Runner) -> dict:
         to_internal = scene.units.factor_to(internal.units, TIME)

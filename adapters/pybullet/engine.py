@@ -77,9 +77,6 @@ class PybulletEngine(SteppingEngine):
 
         disconnect(built)
 
-    def rebuild_overlap(self, built) -> dict:
-        return built.rebuild_overlap
-
     def metadata(self, scene: Scene, internal: Scene, config: PybulletSettings, built,
                  runner) -> dict:
         to_internal = scene.units.factor_to(internal.units, TIME)
