@@ -45,7 +45,10 @@ from clearbench.harness.studies.campaign.metamodel import (
     fit_kriging,
     input_distribution,
 )
-from clearbench.harness.studies.campaign.metamodel_estimates import bootstrap_estimates
+from clearbench.harness.studies.campaign.metamodel_estimates import (
+    FIGURES_METHOD,
+    bootstrap_estimates,
+)
 from clearbench.harness.studies.campaign.rare_events import (
     confirmation_points,
     failure_probability,
@@ -201,7 +204,7 @@ def run_metamodel_campaign(definition: CampaignDefinition, store: ResultsStore, 
             run_samples(definition, samples, store, scheduler=scheduler, workers=workers,
                         progress=progress)
             table = design_table(definition, store, size, given)
-        key = _digest(definition.raw, table[["sample", "status"] + [
+        key = _digest(definition.raw, FIGURES_METHOD, table[["sample", "status"] + [
             o.name for o in definition.outputs]].to_dict("list"))
         if key not in cache:
             cache[key] = fit_stage(definition, table, basis)
