@@ -13,8 +13,10 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
+from clearbench.adapters import all_availability
 from clearbench.harness.run.engine_choice import RunInputError, parse_engine_label
 from clearbench.harness.run.runner import Runner
 from clearbench.harness.run.spec import make_run_spec
@@ -155,6 +157,32 @@ def test_reused_workers_serve_several_runs_and_a_crash_replaces_one(tmp_path):
     Runner(store, jobs=1, runs_per_worker=10).run_all(specs)
     statuses = [store.get(s.key)["status"] for s in specs]
     assert statuses == ["ok", "crashed", "ok", "ok"]
+
+
+def test_a_reused_worker_gives_every_engine_the_trajectory_of_a_fresh_one(tmp_path):
+    # the comparison reuses its workers (COMPARE_RUNS_PER_WORKER): a run must not depend on
+    # what ran before it in the process. Each available engine on two scenes, once in a fresh
+    # process per run and once all in one process in reverse order (every engine after the
+    # others): the same arrays bit for bit, and the same figures
+    engines = [a.engine for a in all_availability() if a.available]
+    specs = [make_run_spec(scene, engine, horizon=horizon)
+             for scene, horizon in (("bouncing-ball-e0", 0.2), ("clearance-pendulum", 0.05))
+             for engine in engines]
+    fresh = ResultsStore(tmp_path / "fresh")
+    reused = ResultsStore(tmp_path / "reused")
+    Runner(fresh, jobs=1, runs_per_worker=1).run_all(specs)
+    Runner(reused, jobs=1, runs_per_worker=len(specs)).run_all(specs[::-1])
+    for spec in specs:
+        one, other = fresh.get(spec.key), reused.get(spec.key)
+        assert (one["status"], one["metrics"]) == (other["status"], other["metrics"]), spec.label
+        first, second = fresh.load_trajectory(spec.key), reused.load_trajectory(spec.key)
+        if first is None:
+            assert second is None, spec.label
+            continue
+        for name in ("times", "positions", "orientations", "velocities",
+                     "contact_normal_force"):
+            assert np.array_equal(getattr(first, name), getattr(second, name),
+                                  equal_nan=True), (spec.label, name)
 
 
 def _children(pid: int) -> set[int]:

@@ -38,19 +38,29 @@ def add_store_option(parser: argparse.ArgumentParser) -> None:
                         f"{DEFAULT_STORE})")
 
 
+#: Runs a worker process serves before it is replaced (a crashed or timed-out one always is)
+#: in the commands of many short runs (compare, demo, regress): a fresh process per run spent
+#: about 1.5 s each starting, importing its engine and loading the compiled kernels, while a run
+#: in a reused worker gives the same trajectory bit for bit (docs/harness.md, "Isolation").
+MANY_RUNS_PER_WORKER = 20
+
+
 def add_runner_options(parser: argparse.ArgumentParser, timeout: float = DEFAULT_TIMEOUT,
-                       engine_module: bool = True) -> None:
-    """--store, --jobs, --timeout, --runs-per-worker, --rerun, --engine-module (unless not
-    ``engine_module``: a command that runs only the reference engine), --no-progress."""
+                       engine_module: bool = True, runs_per_worker: int = 1) -> None:
+    """--store, --jobs, --timeout, --runs-per-worker (default ``runs_per_worker``), --rerun,
+    --engine-module (unless not ``engine_module``: a command that runs only the reference
+    engine), --no-progress."""
     add_store_option(parser)
     parser.add_argument("--jobs", "-j", type=int, default=None,
                         help=f"parallel worker processes (default: usable cores, here "
                         f"{default_jobs()})")
     parser.add_argument("--timeout", type=float, default=timeout, metavar="SECONDS",
                         help=f"wall-clock limit of each run (default {timeout:g} s)")
-    parser.add_argument("--runs-per-worker", type=int, default=1, metavar="N",
-                        help="runs a worker process serves before it is replaced (default 1: a "
-                        "fresh process per run; a crashed or timed-out worker is always replaced)")
+    fresh = ": a fresh process per run" if runs_per_worker == 1 else ""
+    parser.add_argument("--runs-per-worker", type=int, default=runs_per_worker, metavar="N",
+                        help="runs a worker process serves before it is replaced (default "
+                        f"{runs_per_worker}{fresh}; a crashed or timed-out worker is always "
+                        "replaced)")
     parser.add_argument("--rerun", action="store_true",
                         help="run again even when the run is already in the store")
     if engine_module:

@@ -8,6 +8,7 @@ import time
 from clearbench.harness.cli.c60 import c60_plan_specs, print_c60
 from clearbench.harness.cli.commands import command_help
 from clearbench.harness.cli.common import (
+    MANY_RUNS_PER_WORKER,
     UserError,
     add_engine_option,
     add_runner_options,
@@ -96,7 +97,7 @@ def add_compare_options(parser: argparse.ArgumentParser) -> None:
                         "(default; shortened horizons, a few minutes), `full` (hours) or none")
     parser.add_argument("--out", default="reports/out", metavar="DIR",
                         help="report directory (default reports/out)")
-    add_runner_options(parser, timeout=300.0)
+    add_runner_options(parser, timeout=300.0, runs_per_worker=MANY_RUNS_PER_WORKER)
 
 
 def run_compare(args: argparse.Namespace) -> int:

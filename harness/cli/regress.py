@@ -8,6 +8,7 @@ import time
 
 from clearbench.harness.cli.commands import command_help
 from clearbench.harness.cli.common import (
+    MANY_RUNS_PER_WORKER,
     UserError,
     add_engine_module_option,
     add_engine_option,
@@ -54,8 +55,9 @@ def register(subparsers) -> None:
                         help="re-measure the baseline's results and tolerances")
     parser.add_argument("--jobs", "-j", type=int, default=None,
                         help="parallel workers (default: usable cores)")
-    parser.add_argument("--runs-per-worker", type=int, default=1, metavar="N",
-                        help="runs a worker serves before it is replaced (default 1)")
+    parser.add_argument("--runs-per-worker", type=int, default=MANY_RUNS_PER_WORKER,
+                        metavar="N", help="runs a worker serves before it is replaced (default "
+                        f"{MANY_RUNS_PER_WORKER}; a crashed or timed-out one always is)")
     parser.add_argument("--timeout", type=float, default=None, metavar="SECONDS",
                         help="wall-clock limit of every run (default: each entry's own, 300 s "
                         "unless it says; numba cannot cache kernels compiled with NUMBA_OPT=0, "
