@@ -155,7 +155,14 @@ from clearbench.kernels.gaps import (
     enclosing_ring_gap,
     pair_contacts,
 )
-from clearbench.kernels.quaternion import quat_multiply, quat_normalize, quat_to_matrix
+from clearbench.kernels.quaternion import (
+    quat_multiply,
+    quat_multiply_batch,
+    quat_normalize,
+    quat_normalize_batch,
+    quat_to_matrix,
+    quat_to_matrix_batch,
+)
 
 if TYPE_CHECKING:  # the kernels and this module never need the scene dataclasses at run time
     from clearbench.scenarios.shapes import Shape
@@ -184,6 +191,8 @@ __all__ = [
     "contacts_between",
     "enclosing_ring_gap",
     "ring_encloses_axis",
+    "shape_world_placements",
+    "smallest_gaps",
     "frame_tangent",
     "kind_name",
     "pack_shape_parameters",
@@ -326,6 +335,64 @@ def shape_world_placement(
         quat_multiply(body_quaternion, np.asarray(shape.orientation, dtype=np.float64))
     )
     return position, quat_to_matrix(orientation)
+
+
+def shape_world_placements(shape: Shape, body_positions, body_quaternions
+                           ) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`shape_world_placement` at T body poses at once: ``body_positions`` (T, 3) [L],
+    ``body_quaternions`` (T, 4) -> shape positions (T, 3) [L], rotations (T, 3, 3). The same
+    arithmetic, vectorised (equal to round-off, not bit for bit)."""
+    quaternions = quat_normalize_batch(np.asarray(body_quaternions, dtype=np.float64))
+    rotations = quat_to_matrix_batch(quaternions)
+    offset = np.asarray(shape.position, dtype=np.float64)
+    positions = np.asarray(body_positions, dtype=np.float64) + np.einsum(
+        "tij,j->ti", rotations, offset)
+    orientations = quat_normalize_batch(
+        quat_multiply_batch(quaternions, np.asarray(shape.orientation, dtype=np.float64)))
+    return positions, np.ascontiguousarray(quat_to_matrix_batch(orientations))
+
+
+def smallest_gaps(shape_a: Shape, poses_a, shape_b: Shape, poses_b,
+                  encloses: bool = False) -> np.ndarray:
+    """Smallest candidate gap of a pair at each of T configurations, (T,) [L]; +inf where the
+    pair yields no candidate. ``poses_a``, ``poses_b``: (positions (T, 3), quaternions (T, 4))
+    of the two BODY frames. The gap is min(:func:`contacts_between`(...).gap) at each
+    configuration, with the shapes' placements computed for all T at once and one kernel call
+    per configuration (the cost of measuring a long trajectory).
+
+    A ring that must enclose its journal (``encloses``: a ring against a cylinder) counts a
+    journal beyond the ring as through its wall (:func:`enclosing_ring_gap` with
+    :func:`ring_encloses_axis`'s test): the gap keeps decreasing with the distance instead of
+    turning positive again.
+    """
+    check_supported_pair(shape_a, shape_b)
+    position_a, rotation_a = shape_world_placements(shape_a, *poses_a)
+    position_b, rotation_b = shape_world_placements(shape_b, *poses_b)
+    code_a, code_b = shape_code(shape_a), shape_code(shape_b)
+    params_a, params_b = pack_shape_parameters(shape_a), pack_shape_parameters(shape_b)
+    gap = np.empty(MAX_CONTACTS_PER_PAIR)
+    point_a = np.empty((MAX_CONTACTS_PER_PAIR, 3))
+    point_b = np.empty((MAX_CONTACTS_PER_PAIR, 3))
+    frame = np.empty((MAX_CONTACTS_PER_PAIR, 3, 3))
+    out = np.full(len(position_a), np.inf)
+    for t in range(len(out)):
+        count = pair_contacts(code_a, params_a, position_a[t], rotation_a[t], code_b, params_b,
+                              position_b[t], rotation_b[t], gap, point_a, point_b, frame)
+        if count:
+            out[t] = gap[:count].min()
+    if encloses:
+        ring_first = shape_b.kind == "cylinder"
+        ring, cylinder = (shape_a, shape_b) if ring_first else (shape_b, shape_a)
+        ring_at, axis_at = ((position_a, rotation_a), (position_b, rotation_b))[
+            :: 1 if ring_first else -1]
+        start, span = 0.0, 2.0 * np.pi
+        if ring.kind == "arc":
+            start, span = ring.start_angle, ring.end_angle - ring.start_angle
+        for t in np.nonzero(np.isfinite(out))[0]:
+            inside = axis_crosses_inside_ring(ring_at[0][t], ring_at[1][t], ring.radius, start,
+                                              span, axis_at[0][t], axis_at[1][t][:, 2])
+            out[t] = enclosing_ring_gap(out[t], cylinder.radius, inside)
+    return out
 
 
 @dataclass(frozen=True)

@@ -24,11 +24,7 @@ from clearbench.kernels.quaternion import (
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.energy import Energy, mechanical_energy
 from clearbench.scenarios.features import LOAD_FEATURES, WORK_FEATURES
-from clearbench.scenarios.geometry import (
-    contacts_between,
-    enclosing_ring_gap,
-    ring_encloses_axis,
-)
+from clearbench.scenarios.geometry import ring_encloses_axis, smallest_gaps
 from clearbench.scenarios.loads import (
     LinearSpringDamper,
     TorsionalSpringDamper,
@@ -69,22 +65,6 @@ def _pair_shapes(scene: Scene):
         yield contact, a, shape_a, b, shape_b, bool(encloses)
 
 
-def _smallest_gap(contact, shape_a, pose_a, shape_b, pose_b, encloses: bool = False) -> float:
-    """Smallest gap of one pair at one configuration minus its offset [L]; inf without a
-    candidate. A ring that must enclose its journal (``encloses``) counts a journal beyond the
-    ring as through its wall (:func:`enclosing_ring_gap`): the gap keeps decreasing with the
-    distance instead of turning positive again."""
-    result = contacts_between(shape_a, pose_a, shape_b, pose_b)
-    if not len(result.gap):
-        return math.inf
-    gap = float(np.min(result.gap))
-    if encloses:
-        cylinder = shape_a if shape_a.kind == "cylinder" else shape_b
-        gap = enclosing_ring_gap(gap, cylinder.radius,
-                                 ring_encloses_axis(shape_a, pose_a, shape_b, pose_b))
-    return gap - contact.offset
-
-
 def contact_gaps(scene: Scene, trajectory: Trajectory) -> np.ndarray:
     """Smallest gap of each contact pair (explicit and clearance-joint pairs), minus its offset,
     (T, npair) [L]; +inf where a pair yields no candidate. Read-only; computed once per
@@ -93,11 +73,8 @@ def contact_gaps(scene: Scene, trajectory: Trajectory) -> np.ndarray:
         return _LAST_GAPS[2]
     out = np.full((len(trajectory.times), len(scene.expanded.contacts)), np.inf)
     for k, (contact, a, shape_a, b, shape_b, encloses) in enumerate(_pair_shapes(scene)):
-        xa, qa = _poses(trajectory, a)
-        xb, qb = _poses(trajectory, b)
-        for t in range(len(trajectory.times)):
-            out[t, k] = _smallest_gap(contact, shape_a, (xa[t], qa[t]), shape_b, (xb[t], qb[t]),
-                                      encloses)
+        out[:, k] = smallest_gaps(shape_a, _poses(trajectory, a), shape_b,
+                                  _poses(trajectory, b), encloses) - contact.offset
     out.flags.writeable = False
     _LAST_GAPS[:] = [scene, trajectory, out]
     return out
@@ -121,14 +98,16 @@ def _shape_reach(shape, fallback: float) -> float:
     return float(np.linalg.norm(dimensions)) if dimensions else fallback
 
 
-def _interpolated_pose(com0, com1, q0, q1, local_com, s: float):
-    """Body-frame pose at fraction ``s`` of the straight path between two samples: centre of
-    mass moved linearly, orientation normalised-linearly (nlerp on the short arc)."""
+def _interpolated_poses(com0, com1, q0, q1, local_com, s: np.ndarray):
+    """Body-frame poses (positions (m, 3), quaternions (m, 4)) at the fractions ``s`` (m,) of
+    the straight path between two samples: centre of mass moved linearly, orientation
+    normalised-linearly (nlerp on the short arc)."""
     q1 = q1 if float(np.dot(q0, q1)) >= 0.0 else -q1
+    s = s[:, None]
     q = (1.0 - s) * q0 + s * q1
-    q = q / np.linalg.norm(q)
+    q = q / np.linalg.norm(q, axis=1, keepdims=True)
     com = (1.0 - s) * com0 + s * com1
-    return com - quat_rotate_batch(q[None, :], local_com[None, :])[0], q
+    return com - quat_rotate_batch(q, np.broadcast_to(local_com, com.shape)), q
 
 
 def swept_penetration(scene: Scene, trajectory: Trajectory) -> np.ndarray:
@@ -142,7 +121,7 @@ def swept_penetration(scene: Scene, trajectory: Trajectory) -> np.ndarray:
     smallest feature (:func:`~clearbench.scenarios.scales.contact_feature_sizes`: a slower
     crossing shows on a sample) and exceeds the smaller end gap (otherwise the shapes cannot
     meet in between). It is then cut into steps of at most half that feature (at most
-    :data:`MAX_SWEPT_SUBSTEPS`), the poses interpolated by :func:`_interpolated_pose`.
+    :data:`MAX_SWEPT_SUBSTEPS`), the poses interpolated by :func:`_interpolated_poses`.
     """
     gaps = contact_gaps(scene, trajectory)
     features = contact_feature_sizes(scene)
@@ -171,14 +150,18 @@ def swept_penetration(scene: Scene, trajectory: Trajectory) -> np.ndarray:
         ends = np.minimum(gaps[:-1, k], gaps[1:, k])
         for i in np.nonzero((motion > 0.5 * feature) & (ends < motion))[0]:
             steps = min(MAX_SWEPT_SUBSTEPS, math.ceil(motion[i] / (0.5 * feature)))
-            for s in np.arange(1, steps) / steps:
-                pose_a = _interpolated_pose(coms[i, a], coms[i + 1, a], q[i, a], q[i + 1, a],
-                                            local_coms[a], s)
-                pose_b = _interpolated_pose(coms[i, b], coms[i + 1, b], q[i, b], q[i + 1, b],
-                                            local_coms[b], s)
-                gap = _smallest_gap(contact, shape_a, pose_a, shape_b, pose_b, encloses)
-                if math.isfinite(gap):
-                    out[k] = max(out[k], -gap)
+            if steps < 2:
+                continue
+            fractions = np.arange(1, steps) / steps
+            poses_a = _interpolated_poses(coms[i, a], coms[i + 1, a], q[i, a], q[i + 1, a],
+                                          local_coms[a], fractions)
+            poses_b = _interpolated_poses(coms[i, b], coms[i + 1, b], q[i, b], q[i + 1, b],
+                                          local_coms[b], fractions)
+            gaps_between = smallest_gaps(shape_a, poses_a, shape_b, poses_b,
+                                         encloses) - contact.offset
+            finite = gaps_between[np.isfinite(gaps_between)]
+            if len(finite):
+                out[k] = max(out[k], float(-finite.min()))
     return out
 
 
