@@ -381,16 +381,13 @@ def smallest_gaps(shape_a: Shape, poses_a, shape_b: Shape, poses_b,
         if count:
             out[t] = gap[:count].min()
     if encloses:
-        ring_first = shape_b.kind == "cylinder"
-        ring, cylinder = (shape_a, shape_b) if ring_first else (shape_b, shape_a)
-        ring_at, axis_at = ((position_a, rotation_a), (position_b, rotation_b))[
-            :: 1 if ring_first else -1]
-        start, span = 0.0, 2.0 * np.pi
-        if ring.kind == "arc":
-            start, span = ring.start_angle, ring.end_angle - ring.start_angle
+        placed_a = (shape_a, position_a, rotation_a)
+        placed_b = (shape_b, position_b, rotation_b)
+        (ring, ring_position, ring_rotation), (cylinder, axis_point, axis_rotation) = (
+            (placed_a, placed_b) if shape_b.kind == "cylinder" else (placed_b, placed_a))
         for t in np.nonzero(np.isfinite(out))[0]:
-            inside = axis_crosses_inside_ring(ring_at[0][t], ring_at[1][t], ring.radius, start,
-                                              span, axis_at[0][t], axis_at[1][t][:, 2])
+            inside = _axis_inside_ring(ring, ring_position[t], ring_rotation[t], axis_point[t],
+                                       axis_rotation[t])
             out[t] = enclosing_ring_gap(out[t], cylinder.radius, inside)
     return out
 
@@ -487,6 +484,14 @@ def ring_encloses_axis(shape_a: Shape, pose_a, shape_b: Shape, pose_b) -> bool |
         ((shape_a, pose_a), (shape_b, pose_b)), key=lambda item: item[0].kind == "cylinder")
     ring_position, ring_rotation = shape_world_placement(ring, *ring_pose)
     axis_point, axis_rotation = shape_world_placement(cylinder, *cylinder_pose)
+    return _axis_inside_ring(ring, ring_position, ring_rotation, axis_point, axis_rotation)
+
+
+def _axis_inside_ring(ring: Shape, ring_position, ring_rotation, axis_point,
+                      axis_rotation) -> bool:
+    """:func:`~clearbench.kernels.gaps.axis_crosses_inside_ring` for a placed ring (circle or
+    arc) and a placed cylinder's frame (its axis the frame's z): world positions (3,) [L],
+    rotations (3, 3)."""
     start, span = 0.0, 2.0 * np.pi
     if ring.kind == "arc":
         start, span = ring.start_angle, ring.end_angle - ring.start_angle

@@ -160,7 +160,7 @@ def test_reused_workers_serve_several_runs_and_a_crash_replaces_one(tmp_path):
 
 
 def test_a_reused_worker_gives_every_engine_the_trajectory_of_a_fresh_one(tmp_path):
-    # the comparison reuses its workers (COMPARE_RUNS_PER_WORKER): a run must not depend on
+    # compare, demo and regress reuse their workers (MANY_RUNS_PER_WORKER): a run must not depend on
     # what ran before it in the process. Each available engine on two scenes, once in a fresh
     # process per run and once all in one process in reverse order (every engine after the
     # others): the same arrays bit for bit, and the same figures
