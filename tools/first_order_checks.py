@@ -2,13 +2,15 @@
 
 For each input x_i of one output y, five estimates of S1_i = Var E[y | x_i] / Var y from the
 same runs: SALib's delta method (as the campaign report shows it), SALib's RBD-FAST (both with
-their bootstrap half-widths), the squared standardised
-regression coefficient (S1 for a linear response of independent inputs), a cubic regression
-of y on x_i alone, and 20 equal-count bins of x_i (the between-bin variance less its expected
-value under no effect, (bins - 1) Var y / n). They disagree where one estimator is biased or
-noisy; the metamodel campaign's report compares its S1 with SALib's.
+their bootstrap half-widths), the squared standardised regression coefficient (S1 for a linear
+response of independent inputs), a cubic regression of y on x_i alone, and 20 equal-count
+bins of x_i (the between-bin variance less its expected value under no effect,
+(bins - 1) Var y / n). They disagree where one estimator is biased or noisy; the metamodel
+campaign's report compares its S1 with SALib's delta method.
 
     .venv/bin/python -m tools.first_order_checks c60-paper FC-3 [--csv FILE]
+    .venv/bin/python -m tools.first_order_checks c60-paper all \\
+        --metamodel reports/campaigns/c60-paper-metamodel.json
     .venv/bin/python -m tools.first_order_checks --linear-test
 
 ``--linear-test``: SALib's delta-method S1 and RBD-FAST on a linear response of 7 standard
@@ -20,6 +22,7 @@ with how often each estimator's own 95 % interval holds the exact value.
 from __future__ import annotations
 
 import argparse
+import json
 
 import numpy as np
 import pandas as pd
@@ -97,6 +100,9 @@ def main() -> None:
     parser.add_argument("output", nargs="?")
     parser.add_argument("--csv", default=None,
                         help="the campaign's CSV (default reports/campaigns/CAMPAIGN.csv)")
+    parser.add_argument("--metamodel", default=None, metavar="JSON",
+                        help="a metamodel campaign's report JSON: its S1 intervals beside, "
+                        "OUTPUT 'all' for each output it holds")
     parser.add_argument("--linear-test", action="store_true",
                         help="SALib's estimators on a linear response and Ishigami's function")
     args = parser.parse_args()
@@ -107,24 +113,46 @@ def main() -> None:
         parser.error("CAMPAIGN and OUTPUT are needed (or --linear-test)")
     definition = load_campaign(args.campaign)
     table = pd.read_csv(args.csv or f"reports/campaigns/{args.campaign}.csv")
-    table = table[(table["status"] == "ok") & np.isfinite(table[args.output])]
-    names = [law.name for law in definition.inputs]
-    x = table[names].to_numpy(float)
-    y = table[args.output].to_numpy(float)
-    bounds = np.column_stack([x.min(axis=0), x.max(axis=0)])
-    salib = sensitivities(x, y, names, bounds, seed=definition.seed)
+    metamodel = None
+    if args.metamodel:
+        with open(args.metamodel, encoding="utf-8") as handle:
+            reported = json.load(handle)["outputs"]
+        metamodel = {entry["name"]: entry["s1"] for entry in reported}
+    for output in (metamodel or {}) if args.output == "all" else [args.output]:
+        compare_output(definition, table, output, None if metamodel is None
+                       else metamodel[output])
+
+
+def compare_output(definition, table: pd.DataFrame, output: str, metamodel_s1) -> None:
+    """Print the five estimates of each input's S1 for ``output``; with ``metamodel_s1`` (a
+    list of {value, low, high} per input), the metamodel's interval, and a mark where an
+    estimate's interval (S1 +- its half-width) does not overlap it."""
     from SALib.analyze import rbd_fast  # lazily, as statistics.sensitivities does
 
+    table = table[(table["status"] == "ok") & np.isfinite(table[output])]
+    names = [law.name for law in definition.inputs]
+    x = table[names].to_numpy(float)
+    y = table[output].to_numpy(float)
+    bounds = np.column_stack([x.min(axis=0), x.max(axis=0)])
+    salib = sensitivities(x, y, names, bounds, seed=definition.seed)
     problem = {"num_vars": len(names), "names": names, "bounds": bounds.tolist()}
     fast = rbd_fast.analyze(problem, x, y, seed=definition.seed)
-    print(f"{args.output} on {len(y)} runs; linear R^2 {salib.r_squared:.3f}")
-    print(f"{'input':<8}{'SALib delta':>18}{'RBD-FAST':>18}{'SRC^2':>8}{'cubic':>8}{'bins':>8}")
+    print(f"{output} on {len(y)} runs; linear R^2 {salib.r_squared:.3f}"
+          + ("; * : no overlap with the metamodel's interval" if metamodel_s1 else ""))
+    print(f"{'input':<8}{'SALib delta':>19}{'RBD-FAST':>19}{'SRC^2':>8}{'cubic':>8}{'bins':>8}"
+          + (f"{'metamodel':>24}" if metamodel_s1 else ""))
     for i, name in enumerate(names):
-        print(f"{name:<8}{salib.s1[i]:>10.3f} +- {salib.s1_confidence[i]:.3f}"
-              f"{fast['S1'][i]:>10.3f} +- {fast['S1_conf'][i]:.3f}"
+        marks, interval = ["", ""], ""
+        if metamodel_s1:
+            low, high = metamodel_s1[i]["low"], metamodel_s1[i]["high"]
+            for k, (value, half) in enumerate([(salib.s1[i], salib.s1_confidence[i]),
+                                               (fast["S1"][i], fast["S1_conf"][i])]):
+                marks[k] = " " if value + half >= low and value - half <= high else "*"
+            interval = (f"{metamodel_s1[i]['value']:>10.3f} [{low:.3f}, {high:.3f}]")
+        print(f"{name:<8}{salib.s1[i]:>10.3f} +- {salib.s1_confidence[i]:.3f}{marks[0]}"
+              f"{fast['S1'][i]:>10.3f} +- {fast['S1_conf'][i]:.3f}{marks[1]}"
               f"{salib.src[i] ** 2:>8.3f}{cubic_share(x[:, i], y):>8.3f}"
-              f"{binned_share(x[:, i], y):>8.3f}")
-
+              f"{binned_share(x[:, i], y):>8.3f}{interval}")
 
 if __name__ == "__main__":
     main()
