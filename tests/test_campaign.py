@@ -21,6 +21,7 @@ from scipy import stats
 from clearbench.harness.cli.main import main
 from clearbench.harness.report.page import write_report
 from clearbench.harness.run.store import ResultsStore
+from clearbench.harness.studies.campaign import execution
 from clearbench.harness.studies.campaign.definition import (
     SHIPPED,
     CampaignError,
@@ -29,7 +30,11 @@ from clearbench.harness.studies.campaign.definition import (
     with_overrides,
 )
 from clearbench.harness.studies.campaign.designs import sample_inputs, scene_parameters
-from clearbench.harness.studies.campaign.execution import plan_samples, run_campaign
+from clearbench.harness.studies.campaign.execution import (
+    execute_run,
+    plan_samples,
+    run_campaign,
+)
 from clearbench.harness.studies.campaign.report import (
     load_written_sections,
     write_campaign_report,
@@ -281,6 +286,29 @@ def test_collect_takes_the_statistic_over_the_last_window():
 
 
 # ---------------------------------------------------------------------- running on Dask
+def test_a_dask_worker_keeps_its_run_process_warm_between_samples():
+    # execute_run is what a Dask task calls: with runs_per_worker = 2 the first two samples
+    # run in one process, which is then replaced; each sample's row is that of a fresh process
+    samples = plan_samples(parse_campaign(pendulum_campaign(samples=3)))
+    fresh = [execute_run(s.spec, runs_per_worker=1) for s in samples]
+    warm, processes = [], []
+    try:
+        for sample in samples:
+            warm.append(execute_run(sample.spec, runs_per_worker=2))
+            runner = execution._WARM_RUNNERS[2]
+            processes.append([slot.process.pid for slot in runner._slots])
+    finally:
+        execution._WARM_RUNNERS.pop(2).close()
+        execution._WARM_RUNNERS.pop(1).close()
+    # kept after the first sample, retired after the second, a new one for the third
+    assert len(processes[0]) == 1 and processes[1] == [] and len(processes[2]) == 1
+    assert processes[0] != processes[2]
+    for one, other in zip(fresh, warm, strict=True):
+        assert one["row"]["status"] == other["row"]["status"] == "ok"
+        assert one["row"]["metrics"] == other["row"]["metrics"]
+        assert one["trajectory"] is not None and other["trajectory"] is not None
+
+
 def test_a_campaign_runs_on_a_local_cluster_resumes_and_reports(tmp_path):
     definition = parse_campaign(pendulum_campaign(samples=4))
     store = ResultsStore(tmp_path / "store")

@@ -24,6 +24,7 @@ from clearbench.harness.cli.common import (
     add_store_option,
     open_store,
 )
+from clearbench.harness.run.runner import MANY_RUNS_PER_WORKER
 from clearbench.harness.studies.campaign.adaptive import (
     design_table,
     load_state,
@@ -62,6 +63,10 @@ def register(subparsers) -> None:
                      "default: a LocalCluster on this machine ($CLEARBENCH_DASK_SCHEDULER)")
     run.add_argument("--workers", type=int, default=None,
                      help="LocalCluster worker processes (default: usable cores)")
+    run.add_argument("--runs-per-worker", type=int, default=MANY_RUNS_PER_WORKER, metavar="N",
+                     help="samples a worker's run process serves before it is replaced (default "
+                     f"{MANY_RUNS_PER_WORKER}; 1: a fresh process per sample; a crashed or "
+                     "timed-out one always is)")
     run.add_argument("--no-progress", action="store_true", help="no progress bar")
     _add_given_option(run)
     run.set_defaults(handler=_run)
@@ -130,6 +135,8 @@ def _run(args: argparse.Namespace) -> int:
     definition = _definition(args)
     if args.workers is not None and args.workers < 1:
         raise UserError(f"--workers {args.workers}: must be >= 1")
+    if args.runs_per_worker < 1:
+        raise UserError(f"--runs-per-worker {args.runs_per_worker}: must be >= 1")
     workers = args.workers or max(1, len(os.sched_getaffinity(0)))
     store = open_store(args)
     progress = not args.no_progress and sys.stderr.isatty()
@@ -137,14 +144,15 @@ def _run(args: argparse.Namespace) -> int:
     try:
         if definition.method == "metamodel":
             state = run_metamodel_campaign(definition, store, scheduler=args.scheduler,
-                                           workers=workers, progress=progress, given=given)
+                                           workers=workers, progress=progress, given=given,
+                                           runs_per_worker=args.runs_per_worker)
             short = state["stages"][-1]["short"]
             print(f"{definition.name}: stopped ({state['stop']}) after {state['runs']} runs "
                   f"of {definition.samples}" + (": " + "; ".join(short) if short else "")
                   + f"; state in {state_path(store, definition)}")
             return 0
         outcome = run_campaign(definition, store, scheduler=args.scheduler, workers=workers,
-                               progress=progress)
+                               progress=progress, runs_per_worker=args.runs_per_worker)
     except CampaignError as error:
         raise UserError(f"{args.campaign}: {error}") from None
     print(f"{definition.name}: {outcome.planned} samples planned, {outcome.already} already in "

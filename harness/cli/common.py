@@ -38,13 +38,6 @@ def add_store_option(parser: argparse.ArgumentParser) -> None:
                         f"{DEFAULT_STORE})")
 
 
-#: Runs a worker process serves before it is replaced (a crashed or timed-out one always is)
-#: in the commands of many short runs (compare, demo, regress): a fresh process per run spent
-#: about 1.5 s each starting, importing its engine and loading the compiled kernels, while a run
-#: in a reused worker gives the same trajectory bit for bit (docs/harness.md, "Isolation").
-MANY_RUNS_PER_WORKER = 20
-
-
 def add_runner_options(parser: argparse.ArgumentParser, timeout: float = DEFAULT_TIMEOUT,
                        engine_module: bool = True, runs_per_worker: int = 1) -> None:
     """--store, --jobs, --timeout, --runs-per-worker (default ``runs_per_worker``), --rerun,

@@ -8,7 +8,6 @@ import time
 from clearbench.harness.cli.c60 import c60_plan_specs, print_c60
 from clearbench.harness.cli.commands import command_help
 from clearbench.harness.cli.common import (
-    MANY_RUNS_PER_WORKER,
     UserError,
     add_engine_option,
     add_runner_options,
@@ -20,6 +19,7 @@ from clearbench.harness.cli.scenes import check_round_trip, print_engines
 from clearbench.harness.cli.sweep import print_work_precision
 from clearbench.harness.report.page import write_report
 from clearbench.harness.run.engine_choice import RunInputError, resolve_engine
+from clearbench.harness.run.runner import MANY_RUNS_PER_WORKER
 from clearbench.harness.studies.c60_comparison import PLAN_NAMES
 from clearbench.harness.studies.stability import available_engines, plan_stability
 from clearbench.harness.studies.sweep import (

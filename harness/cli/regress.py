@@ -8,13 +8,13 @@ import time
 
 from clearbench.harness.cli.commands import command_help
 from clearbench.harness.cli.common import (
-    MANY_RUNS_PER_WORKER,
     UserError,
     add_engine_module_option,
     add_engine_option,
     engine_modules,
 )
 from clearbench.harness.run.engine_choice import RunInputError
+from clearbench.harness.run.runner import MANY_RUNS_PER_WORKER
 from clearbench.harness.studies.regress import (
     DEFAULT_BASELINE,
     compare,

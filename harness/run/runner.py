@@ -41,6 +41,12 @@ LOG = logging.getLogger(__name__)
 MEASURE_TIMEOUT = 600.0
 #: Seconds to wait for a worker to exit after it was asked to.
 EXIT_GRACE = 5.0
+#: Runs a worker process serves before it is replaced (a crashed or timed-out one always is)
+#: where many runs are made (compare, demo, regress, campaigns): a fresh process per run spends
+#: about 1.5 s starting, importing its engine and loading the compiled kernels (more on a loaded
+#: machine), while a run in a reused worker gives the same trajectory bit for bit
+#: (docs/harness.md, "Isolation").
+MANY_RUNS_PER_WORKER = 20
 
 
 def default_jobs() -> int:
@@ -115,13 +121,20 @@ class Runner:
         Called after each run is recorded as ``on_finished(done, total, spec, record)``:
         ``done`` runs of the ``total`` this :meth:`run_all` call runs (those served from the
         store not counted). The CLI prints a progress line with it.
+    keep_workers : bool
+        Keep the worker processes between :meth:`run_all` calls (each still replaced after
+        ``runs_per_worker`` runs, a crash or a timeout), until :meth:`close`: a caller that
+        runs one job per call (a campaign's Dask task) keeps its workers warm. The ``store``
+        attribute may be changed between calls.
     """
 
     def __init__(self, store: ResultsStore, jobs: int | None = None, runs_per_worker: int = 1,
                  progress: bool = False, measure_timeout: float = MEASURE_TIMEOUT,
                  environment: Mapping[str, str] | None = None,
-                 on_finished: Callable[[int, int, RunSpec, RunRecord], None] | None = None):
+                 on_finished: Callable[[int, int, RunSpec, RunRecord], None] | None = None,
+                 keep_workers: bool = False):
         self.store = store
+        self.keep_workers = keep_workers
         # Trajectory files of runs a killed sweep left half written (``.KEY.PID.tmp.npz``).
         store.clean_partial_files()
         self.environment = worker_environment(environment)
@@ -203,12 +216,15 @@ class Runner:
             from tqdm import tqdm  # lazy: only for an interactive progress bar
 
             bar = tqdm(total=len(queue), unit="run", desc="runs", leave=False)
+        completed = False
         try:
             self._loop(queue, outcome, bar)
+            completed = True
         finally:
             if bar is not None:
                 bar.close()
-            self.close()
+            if not (completed and self.keep_workers):
+                self.close()
         return outcome
 
     def _dispatch(self, slot: _Slot, job: RunJob) -> None:

@@ -30,6 +30,7 @@ from dataclasses import asdict
 import numpy as np
 
 import clearbench
+from clearbench.harness.run.runner import MANY_RUNS_PER_WORKER
 from clearbench.harness.run.store import ResultsStore
 from clearbench.harness.studies.campaign.definition import CampaignDefinition, CampaignError
 from clearbench.harness.studies.campaign.execution import (
@@ -182,10 +183,12 @@ def _stage_sizes(definition: CampaignDefinition) -> list[int]:
 def run_metamodel_campaign(definition: CampaignDefinition, store: ResultsStore, *,
                            scheduler: str | None = None, workers: int = 2,
                            progress: bool = False, given=None,
-                           on_stage: Callable[[dict], None] | None = None) -> dict:
+                           on_stage: Callable[[dict], None] | None = None,
+                           runs_per_worker: int = MANY_RUNS_PER_WORKER) -> dict:
     """Run ``definition`` (``method = "metamodel"``) to its stop; returns the state (also
     written beside the store): the stages, the stop and its reason, the rare-event estimates
-    and the confirmation runs."""
+    and the confirmation runs. ``runs_per_worker`` as for
+    :func:`~.execution.run_campaign`."""
     if definition.metamodel is None:
         raise CampaignError("method", definition.method, "is not \"metamodel\"")
     settings = definition.metamodel
@@ -202,7 +205,7 @@ def run_metamodel_campaign(definition: CampaignDefinition, store: ResultsStore, 
             samples = [s for s in plan_samples(definition, 0, size)
                        if s.index in set(pending["sample"])]
             run_samples(definition, samples, store, scheduler=scheduler, workers=workers,
-                        progress=progress)
+                        progress=progress, runs_per_worker=runs_per_worker)
             table = design_table(definition, store, size, given)
         key = _digest(definition.raw, FIGURES_METHOD, table[["sample", "status"] + [
             o.name for o in definition.outputs]].to_dict("list"))
@@ -224,13 +227,13 @@ def run_metamodel_campaign(definition: CampaignDefinition, store: ResultsStore, 
     state.pop("rare_events", None)
     _save_state(store, definition, state)   # the stages, before the confirmation runs
     state["rare_events"] = _rare_events(definition, store, table, final, distribution, basis,
-                                        scheduler, workers, progress)
+                                        scheduler, workers, progress, runs_per_worker)
     _save_state(store, definition, state)
     return state
 
 
 def _rare_events(definition, store, table, final, distribution, basis, scheduler, workers,
-                 progress) -> list[dict]:
+                 progress, runs_per_worker) -> list[dict]:
     """Failure probabilities of the outputs with limits, and their confirmation runs."""
     settings = definition.metamodel
     ok = table[table["status"] == "ok"]
@@ -270,7 +273,7 @@ def _rare_events(definition, store, table, final, distribution, basis, scheduler
     if points:
         samples = plan_points(definition, np.array(points), CONFIRMATION_START)
         run_samples(definition, samples, store, scheduler=scheduler, workers=workers,
-                    progress=progress,
+                    progress=progress, runs_per_worker=runs_per_worker,
                     label=lambda s: f"confirmation-{s.index - CONFIRMATION_START}")
         results = campaign_table(definition, store, samples)
         for (event, side, run), (_, row) in zip(owners, results.iterrows(), strict=True):

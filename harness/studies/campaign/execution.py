@@ -4,10 +4,13 @@ The client (this process) plans every sample's :class:`~clearbench.harness.run.s
 (validating all of them before anything runs), skips the samples whose run key is already in
 the store, and submits the rest to a Dask cluster: a ``LocalCluster`` on this machine by default,
 or an existing scheduler given by address (e.g. one started by dask-jobqueue on SLURM, PBS or
-OAR). On a worker, a task runs its sample with the harness's own :class:`Runner` (a fresh worker
-process per run, with its wall-clock limit: a crash, hang or divergence is a recorded status) in
-a private temporary store, and returns the run's row and trajectory. The client alone writes to
-the campaign's store, one transaction per sample, as results arrive.
+OAR). On a worker, a task runs its sample with the harness's own :class:`Runner` in a private
+temporary store, and returns the run's row and trajectory. The Runner's run process, with the
+run's wall-clock limit (a crash, hang or divergence is a recorded status), is kept warm between
+the tasks of a Dask worker and replaced after ``runs_per_worker`` runs, a crash or a timeout:
+samples after a worker's first do not pay a fresh interpreter's start, imports and kernel
+loading. The client alone writes to the campaign's store, one transaction per sample, as
+results arrive.
 
 Hence a campaign killed at any point (``kill -9`` of the client, a lost Dask worker) resumes
 with no sample lost or recorded twice: a sample is either in the store, complete, or it is run
@@ -37,7 +40,7 @@ import numpy as np
 
 from clearbench.adapters.trajectory import RunStatus
 from clearbench.harness.run.engine_choice import RunInputError, resolve_engine
-from clearbench.harness.run.runner import Runner
+from clearbench.harness.run.runner import MANY_RUNS_PER_WORKER, Runner
 from clearbench.harness.run.spec import DEFAULT_TIMEOUT, RunSpec, make_run_spec
 from clearbench.harness.run.store import ResultsStore, RunRecord, machine_info, revision_info
 from clearbench.harness.studies.campaign.definition import CampaignDefinition, CampaignError
@@ -111,11 +114,16 @@ def _check_outputs(definition: CampaignDefinition, spec: RunSpec) -> None:
 
 
 # ---------------------------------------------------------------------- the worker side
-def execute_run(spec: RunSpec) -> dict:
+#: This Dask worker's Runner, kept between tasks, by runs per run process.
+_WARM_RUNNERS: dict[int, Runner] = {}
+
+
+def execute_run(spec: RunSpec, runs_per_worker: int = MANY_RUNS_PER_WORKER) -> dict:
     """Run one sample on a Dask worker; return its store row and trajectory file's bytes.
 
-    The run goes through the harness's :class:`Runner` in a private temporary store: a fresh
-    process with the run's wall-clock limit, so the engine's failures are statuses.
+    The run goes through the harness's :class:`Runner` in a private temporary store: a run
+    process with the run's wall-clock limit, so the engine's failures are statuses. The run
+    process serves ``runs_per_worker`` samples of this Dask worker (1: a fresh one per sample).
     """
     if multiprocessing.current_process().daemon:
         raise RuntimeError("this Dask worker is a daemonic process, which may not start the "
@@ -124,7 +132,13 @@ def execute_run(spec: RunSpec) -> dict:
                            "DASK_DISTRIBUTED__WORKER__DAEMON=False)")
     with tempfile.TemporaryDirectory(prefix="clearbench-campaign-") as folder:
         store = ResultsStore(folder)
-        Runner(store, jobs=1, progress=False).run_all([spec])
+        runner = _WARM_RUNNERS.get(runs_per_worker)
+        if runner is None:
+            runner = Runner(store, jobs=1, runs_per_worker=runs_per_worker, progress=False,
+                            keep_workers=True)
+            _WARM_RUNNERS[runs_per_worker] = runner
+        runner.store = store
+        runner.run_all([spec], rerun=True)
         row = store.get(spec.key)
         path = store.trajectory_path(spec.key)
         data = path.read_bytes() if path.exists() else None
@@ -219,8 +233,8 @@ def _lost_run(sample: CampaignSample, error: BaseException) -> dict:
 
 def run_campaign(definition: CampaignDefinition, store: ResultsStore, *,
                  scheduler: str | None = None, workers: int = 2, progress: bool = False,
-                 on_recorded: Callable[[int, RunRecord], None] | None = None
-                 ) -> CampaignProgress:
+                 on_recorded: Callable[[int, RunRecord], None] | None = None,
+                 runs_per_worker: int = MANY_RUNS_PER_WORKER) -> CampaignProgress:
     """Run every sample of ``definition`` not yet in ``store``.
 
     Parameters
@@ -229,17 +243,20 @@ def run_campaign(definition: CampaignDefinition, store: ResultsStore, *,
         LocalCluster of ``workers`` processes on this machine for this call.
     progress : show a progress bar (rate and time left) on stderr.
     on_recorded : called with (sample index, record) after each sample is stored.
+    runs_per_worker : samples a Dask worker's run process serves before it is replaced (1: a
+        fresh process per sample); a crashed or timed-out one always is.
     """
     return run_samples(definition, plan_samples(definition), store, scheduler=scheduler,
-                       workers=workers, progress=progress, on_recorded=on_recorded)
+                       workers=workers, progress=progress, on_recorded=on_recorded,
+                       runs_per_worker=runs_per_worker)
 
 
 def run_samples(definition: CampaignDefinition, samples: list[CampaignSample],
                 store: ResultsStore, *, scheduler: str | None = None, workers: int = 2,
                 progress: bool = False,
                 on_recorded: Callable[[int, RunRecord], None] | None = None,
-                label: Callable[[CampaignSample], int | str] | None = None
-                ) -> CampaignProgress:
+                label: Callable[[CampaignSample], int | str] | None = None,
+                runs_per_worker: int = MANY_RUNS_PER_WORKER) -> CampaignProgress:
     """Run the ``samples`` of ``definition`` not yet in ``store`` on Dask (see
     :func:`run_campaign`); ``label`` names a sample in the campaign's log (default: its
     index)."""
@@ -271,8 +288,9 @@ def run_samples(definition: CampaignDefinition, samples: list[CampaignSample],
         bar = tqdm(total=len(samples), initial=outcome.already, unit="sample",
                    desc=definition.name, file=sys.stderr, smoothing=0.05)
     try:
-        by_future = {client.submit(execute_run, s.spec, key=f"{definition.name}-{s.index}-"
-                                   f"{s.spec.key}", pure=False): s for s in todo}
+        by_future = {client.submit(execute_run, s.spec, runs_per_worker,
+                                   key=f"{definition.name}-{s.index}-{s.spec.key}", pure=False): s
+                     for s in todo}
         for future in as_completed(by_future):
             sample = by_future.pop(future)
             try:
