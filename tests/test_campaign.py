@@ -10,6 +10,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -295,11 +296,11 @@ def test_a_dask_worker_keeps_its_run_process_warm_between_samples():
     try:
         for sample in samples:
             warm.append(execute_run(sample.spec, runs_per_worker=2))
-            runner = execution._WARM_RUNNERS[2]
+            runner = execution._WARM_RUNNERS[(threading.get_ident(), 2)]
             processes.append([slot.process.pid for slot in runner._slots])
     finally:
-        execution._WARM_RUNNERS.pop(2).close()
-        execution._WARM_RUNNERS.pop(1).close()
+        for key in [(threading.get_ident(), 1), (threading.get_ident(), 2)]:
+            execution._WARM_RUNNERS.pop(key).close()
     # kept after the first sample, retired after the second, a new one for the third
     assert len(processes[0]) == 1 and processes[1] == [] and len(processes[2]) == 1
     assert processes[0] != processes[2]

@@ -30,6 +30,7 @@ import multiprocessing
 import signal
 import sys
 import tempfile
+import threading
 import time
 import uuid
 from collections.abc import Callable
@@ -114,8 +115,9 @@ def _check_outputs(definition: CampaignDefinition, spec: RunSpec) -> None:
 
 
 # ---------------------------------------------------------------------- the worker side
-#: This Dask worker's Runner, kept between tasks, by runs per run process.
-_WARM_RUNNERS: dict[int, Runner] = {}
+#: This Dask worker's Runners, kept between tasks: one per worker thread (a Runner serves one
+#: call at a time) and number of runs per run process.
+_WARM_RUNNERS: dict[tuple[int, int], Runner] = {}
 
 
 def execute_run(spec: RunSpec, runs_per_worker: int = MANY_RUNS_PER_WORKER) -> dict:
@@ -132,11 +134,12 @@ def execute_run(spec: RunSpec, runs_per_worker: int = MANY_RUNS_PER_WORKER) -> d
                            "DASK_DISTRIBUTED__WORKER__DAEMON=False)")
     with tempfile.TemporaryDirectory(prefix="clearbench-campaign-") as folder:
         store = ResultsStore(folder)
-        runner = _WARM_RUNNERS.get(runs_per_worker)
+        key = (threading.get_ident(), runs_per_worker)
+        runner = _WARM_RUNNERS.get(key)
         if runner is None:
             runner = Runner(store, jobs=1, runs_per_worker=runs_per_worker, progress=False,
                             keep_workers=True)
-            _WARM_RUNNERS[runs_per_worker] = runner
+            _WARM_RUNNERS[key] = runner
         runner.store = store
         runner.run_all([spec], rerun=True)
         row = store.get(spec.key)
