@@ -79,7 +79,11 @@ def known_response_test(designs: int = 20, runs: int = 1024) -> None:
     weights = np.array([1.0, 0.8, 0.7, 0.6, 0.9, 0.3, 0.1])
     # E[y | x_i] as a function of x_i's quantile u (constants dropped)
     normal = stats.norm.ppf
-    angle = lambda u: np.pi * (2.0 * u - 1.0)  # noqa: E731 - uniform on [-pi, pi]
+
+    def angle(u):
+        """The quantile ``u`` of a uniform input on [-pi, pi]."""
+        return np.pi * (2.0 * u - 1.0)
+
     cases = [
         ("linear", len(weights), lambda rng: rng.standard_normal((runs, len(weights))),
          lambda x: x @ weights, weights**2 / np.sum(weights**2), [normal] * len(weights)),

@@ -137,11 +137,10 @@ def execute_run(spec: RunSpec, runs_per_worker: int = MANY_RUNS_PER_WORKER) -> d
         key = (threading.get_ident(), runs_per_worker)
         runner = _WARM_RUNNERS.get(key)
         if runner is None:
-            runner = Runner(store, jobs=1, runs_per_worker=runs_per_worker, progress=False,
-                            keep_workers=True)
-            _WARM_RUNNERS[key] = runner
+            runner = _WARM_RUNNERS[key] = Runner(store, jobs=1, runs_per_worker=runs_per_worker,
+                                                 progress=False, keep_workers=True)
         runner.store = store
-        runner.run_all([spec], rerun=True)
+        runner.run_all([spec])
         row = store.get(spec.key)
         path = store.trajectory_path(spec.key)
         data = path.read_bytes() if path.exists() else None
