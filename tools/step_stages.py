@@ -7,8 +7,9 @@ The copy of ``single_step`` below is the same sequence of kernels (free velocity
 then rounds of velocity stage, projection and the closing test until no contact closes); it
 prints each stage's time per step and its share, the activation rounds and solver iterations
 per step, and, of the contacts that closed within a step (and so made it run another round),
-their gap at the start of the step and at the end of the round that found them, in units of
-the activation margin.
+their gap at the start of the step and at the end of the round that found them [the scene's
+length unit]. It copies the projection's path of ``single_step`` (presets with the combined
+projection).
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ from clearbench.ref_solver.compiled.system_arrays import compile_system, history
 from clearbench.ref_solver.forces import remember_angles, rotation_matrices
 from clearbench.ref_solver.projection_kernel import candidates
 from clearbench.ref_solver.step_kernels import free_velocity
+from clearbench.scenarios.library import get_scene
 
 STAGES = ("free velocity", "candidates", "velocity stages", "projections",
           "closing tests", "whole step")
@@ -47,7 +49,7 @@ def _now():
 def timed_steps(s, cfg, memory, t, x, p, v, omega, history, n, seconds, counts, closings):
     """``n`` steps from (t, x, p, v, omega); ``seconds`` (6,) += each stage's time [s],
     ``counts`` (3,) += (activation rounds, solver iterations, closing contacts), ``closings``
-    (K, 4) rows (start gap, end gap [margins], pair, slot) of the closing contacts."""
+    (K, 4) rows (start gap, end gap [L], pair, slot) of the closing contacts."""
     h = cfg.time_step
     theta = cfg.theta
     for _ in range(n):
@@ -87,8 +89,8 @@ def timed_steps(s, cfg, memory, t, x, p, v, omega, history, n, seconds, counts, 
                     if closing[i, k]:
                         j = int(counts[2])
                         if j < closings.shape[0]:
-                            closings[j, 0] = cand[0][i, k] / cfg.activation_margin
-                            closings[j, 1] = cand_new[0][i, k] / cfg.activation_margin
+                            closings[j, 0] = cand[0][i, k]
+                            closings[j, 1] = cand_new[0][i, k]
                             closings[j, 2] = i
                             closings[j, 3] = k
                         counts[2] += 1
@@ -116,11 +118,14 @@ def main() -> None:
     parser.add_argument("steps", type=int, help="steps timed")
     parser.add_argument("skip", type=int, help="steps taken first by the Python step")
     args = parser.parse_args()
-    scene_model = build_model(args.scene)
-    stepper, state = scene_model.stepper, scene_model.state
+    scene = get_scene(args.scene)
+    model = build(scene, create("default").run_settings(scene, RunSettings()))
+    stepper, state = model.stepper, model.state
     for _ in range(args.skip):
         state = stepper.step(state).state
     system, settings = compile_system(stepper)
+    if not settings.projection:
+        parser.error(f"{args.scene}: the default preset steps it without the projection")
     history = np.zeros(history_length(settings))
 
     def run(memory, steps, seconds, counts, closings):
@@ -142,22 +147,15 @@ def main() -> None:
     kept = closings[:int(min(counts[2], KEPT_CLOSINGS))]
     if len(kept):
         levels = [0.0, 0.1, 0.5, 0.9, 1.0]
+        unit = scene.units.length
         print(f"closing contacts {int(counts[2])}; activation margin "
-              f"{settings.activation_margin:.3g}")
-        print("  gap at the step's start / margin, quantiles 0 10 50 90 100 %:",
+              f"{settings.activation_margin:.3g} {unit}")
+        print(f"  gap at the step's start [{unit}], quantiles 0 10 50 90 100 %:",
               np.array2string(np.quantile(kept[:, 0], levels), precision=3))
-        print("  gap at the round's end / margin:",
+        print(f"  gap at the round's end [{unit}]:",
               np.array2string(np.quantile(kept[:, 1], levels), precision=3))
         print("  most frequent (pair, slot):", collections.Counter(
             map(tuple, kept[:, 2:].astype(int).tolist())).most_common(5))
-
-
-def build_model(name: str):
-    """The reference engine's model of library scene ``name`` under the default preset."""
-    from clearbench.scenarios.library import get_scene
-
-    scene = get_scene(name)
-    return build(scene, create("default").run_settings(scene, RunSettings()))
 
 
 if __name__ == "__main__":
