@@ -34,6 +34,7 @@ from clearbench.adapters.exudyn.settings import (
     exudyn_restitution,
 )
 from clearbench.adapters.force_elements import ForceElements
+from clearbench.kernels.jit import njit
 from clearbench.kernels.quaternion import quat_to_matrix, quat_to_matrix_batch
 from clearbench.kernels.time_profiles import profile_integral, profile_value
 from clearbench.scenarios.bodies import Motion
@@ -138,40 +139,51 @@ class BodyMap:
                            + rotation[b] @ np.cross(omega[b], self.com[b]))
         return position, rotation, velocity, omega
 
-    def poses(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Body-frame origins (nb, 3) and unit quaternions (nb, 4) from ODE2 coordinates."""
-        state = self.fixed_pose.copy()
-        moving = self.movable
-        state[moving] = self.reference[moving] + q[self.coordinate_index[moving]]
-        quaternion = state[:, 3:7]
-        quaternion = quaternion / np.linalg.norm(quaternion, axis=1, keepdims=True)
-        return state[:, 0:3], quaternion
+    def euler_parameter_state(self, q: np.ndarray, q_t: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Body-frame origins (nb, 3), unit quaternions (nb, 4), rotations (nb, 3, 3),
+        centre-of-mass velocities (nb, 3, world) and angular velocities (nb, 3, body axes)
+        from the ODE2 coordinates ``q`` and their rates ``q_t`` of Euler-parameter nodes
+        (compiled: :func:`euler_parameter_state`)."""
+        return euler_parameter_state(np.asarray(q, dtype=float), np.asarray(q_t, dtype=float),
+                                     self.coordinate_index, self.reference, self.fixed_pose,
+                                     self.movable, self.com)
 
-    def velocities(self, q: np.ndarray, q_t: np.ndarray,
-                   rotation: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Centre-of-mass velocities (nb, 3, world) and angular velocities (nb, 3, body axes).
 
-        omega_body = 2 vec(conj(p) * dp/dt) for Euler parameters p (w, x, y, z).
-        """
-        nb = self.movable.shape[0]
-        velocity = np.zeros((nb, 3))
-        omega = np.zeros((nb, 3))
-        moving = self.movable
-        if not moving.any():
-            return velocity, omega
-        index = self.coordinate_index[moving]
-        p = self.reference[moving, 3:7] + q[index[:, 3:7]]
-        p = p / np.linalg.norm(p, axis=1, keepdims=True)
-        dp = q_t[index[:, 3:7]]
-        w, x, y, z = p.T
-        dw, dx, dy, dz = dp.T
-        omega_body = 2.0 * np.column_stack([w * dx - x * dw - y * dz + z * dy,
-                                            w * dy + x * dz - y * dw - z * dx,
-                                            w * dz - x * dy + y * dx - z * dw])
-        omega[moving] = omega_body
-        lever = np.cross(omega_body, self.com[moving])
-        velocity[moving] = q_t[index[:, 0:3]] + np.einsum("bij,bj->bi", rotation[moving], lever)
-        return velocity, omega
+@njit(cache=True)
+def euler_parameter_state(q, q_t, coordinate_index, reference, fixed_pose, movable, com):
+    """:meth:`BodyMap.euler_parameter_state` (its arrays as arguments). A node's Euler
+    parameters p are normalised; omega_body = 2 vec(conj(p) * dp/dt); the centre of mass moves
+    at the node's velocity plus R (omega x com). Called before and after every Exudyn step."""
+    nb = movable.shape[0]
+    position = np.empty((nb, 3))
+    quaternion = np.empty((nb, 4))
+    rotation = np.empty((nb, 3, 3))
+    velocity = np.zeros((nb, 3))
+    omega = np.zeros((nb, 3))
+    for b in range(nb):
+        if not movable[b]:
+            position[b] = fixed_pose[b, :3]
+            quaternion[b] = fixed_pose[b, 3:7] / np.sqrt(np.sum(fixed_pose[b, 3:7] ** 2))
+            rotation[b] = quat_to_matrix(quaternion[b])
+            continue
+        index = coordinate_index[b]
+        for i in range(3):
+            position[b, i] = reference[b, i] + q[index[i]]
+        for i in range(4):
+            quaternion[b, i] = reference[b, 3 + i] + q[index[3 + i]]
+        quaternion[b] /= np.sqrt(np.sum(quaternion[b] ** 2))
+        rotation[b] = quat_to_matrix(quaternion[b])
+        w, x, y, z = quaternion[b, 0], quaternion[b, 1], quaternion[b, 2], quaternion[b, 3]
+        dw, dx, dy, dz = q_t[index[3]], q_t[index[4]], q_t[index[5]], q_t[index[6]]
+        omega[b, 0] = 2.0 * (w * dx - x * dw - y * dz + z * dy)
+        omega[b, 1] = 2.0 * (w * dy + x * dz - y * dw - z * dx)
+        omega[b, 2] = 2.0 * (w * dz - x * dy + y * dx - z * dw)
+        lever = np.cross(omega[b], com[b])
+        for i in range(3):
+            velocity[b, i] = q_t[index[i]] + (rotation[b, i, 0] * lever[0]
+                                              + rotation[b, i, 1] * lever[1]
+                                              + rotation[b, i, 2] * lever[2])
+    return position, quaternion, rotation, velocity, omega
 
 
 @dataclass

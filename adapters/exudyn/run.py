@@ -40,10 +40,11 @@ import numpy as np
 from clearbench.adapters.energy_guard import EnergyGuard
 from clearbench.adapters.exudyn.build import BuiltSystem, load_exudyn
 from clearbench.adapters.exudyn.failure import failed_loop, failure_reason
+from clearbench.adapters.exudyn.idle_connectors import IdleConnectors, culling_wanted
 from clearbench.adapters.exudyn.settings import ExudynSettings
 from clearbench.adapters.step_monitor import StepMonitor
 from clearbench.adapters.trajectory import RunStatus
-from clearbench.kernels.quaternion import quat_from_matrix_batch, quat_to_matrix_batch
+from clearbench.kernels.quaternion import quat_from_matrix_batch
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.energy import mechanical_energy, rigid_spring_points
 from clearbench.scenarios.loads import LinearSpringDamper, PointForce
@@ -137,6 +138,12 @@ class Runner:
         self._solver = None
         self._last_time = 0.0
         self._law_cache: tuple[bytes, np.ndarray] | None = None
+        self.idle: IdleConnectors | None = None
+        if culling_wanted(config.cull_idle_connectors, len(built.connectors)):
+            self.idle = IdleConnectors.from_plans(
+                scene, built.pair_plans, [ref.object for ref in built.connectors],
+                built.bodies.com)
+        self._idle_acceleration = 0.0
 
     # ------------------------------------------------------------------ state
     def state(self):
@@ -147,12 +154,8 @@ class Runner:
             position, rotation, velocity, omega = bodies.node_state(self.built.mbs)
             return position, quat_from_matrix_batch(rotation), rotation, velocity, omega
         data = self.built.mbs.systemData
-        q = np.asarray(data.GetODE2Coordinates())
-        q_t = np.asarray(data.GetODE2Coordinates_t())
-        position, quaternion = bodies.poses(q)
-        rotation = quat_to_matrix_batch(quaternion)
-        velocity, omega = bodies.velocities(q, q_t, rotation)
-        return position, quaternion, rotation, velocity, omega
+        return bodies.euler_parameter_state(data.GetODE2Coordinates(),
+                                            data.GetODE2Coordinates_t())
 
     def energy(self, state=None) -> tuple[float, float]:
         """(total, kinetic) mechanical energy of ``state`` (default: the current one):
@@ -246,6 +249,8 @@ class Runner:
                 # calls continue one run, so the previous call's Jacobian is kept, as within
                 # one call (modified Newton updates it when it stops contracting).
                 solver.conv.jacobianUpdateRequested = False
+        if self.idle is not None:
+            self._switch_idle_connectors(mbs, t)
         laws = self.built.law_forces
         if laws is None or self.config.law_loads != "explicit":
             return True
@@ -256,6 +261,16 @@ class Runner:
             mbs.SetLoadParameter(force, "loadVector", wrench[b, :3].tolist())
             mbs.SetLoadParameter(torque, "loadVector", wrench[b, 3:].tolist())
         return True
+
+    def _switch_idle_connectors(self, mbs, t: float) -> None:
+        """Switch the connectors that cannot touch within the margin off and the others on
+        for the coming step (:mod:`.idle_connectors`)."""
+        position, _, rotation, velocity, omega = self.state()
+        idle = self.idle
+        margin = idle.margin(velocity, omega, self._idle_acceleration, self.dt)
+        for index in idle.update(position, rotation, margin, t):
+            mbs.SetObjectParameter(int(idle.objects[index]), "activeConnector",
+                                   bool(idle.active[index]))
 
     def _law_wrench(self, mbs, t: float) -> np.ndarray:
         """Law wrenches at the current Newton iterate, cached per state vector."""
@@ -297,11 +312,7 @@ class Runner:
                 .all()):
             problem = f"non-finite state at t = {t:.6g}"
         if self.built.law_forces is not None:
-            if self.built.bodies.euler_parameters:
-                rotation = quat_to_matrix_batch(self.built.bodies.poses(q)[1])
-            else:
-                rotation = self.state()[2]
-            self.built.law_forces.remember(rotation)
+            self.built.law_forces.remember(self.state()[2])
         recording = (self.count < len(self.record_times)
                      and t >= self.record_times[self.count] - 1e-6 * self.dt)
         problem = self.monitor.after_step(
@@ -330,13 +341,20 @@ class Runner:
                 s.timeIntegration.newton.absoluteTolerance = (
                     self.config.newton_force_tolerance * self.force_scale_value)
         self.newton_absolute_tolerance = s.timeIntegration.newton.absoluteTolerance
+        if self.idle is not None:
+            # A body at rest that starts to move: the applied-force scale over the lightest
+            # moving mass bounds its acceleration (idle_connectors.IdleConnectors.margin).
+            lightest = float(np.min(self.mass[self.movable], initial=np.inf))
+            if np.isfinite(lightest) and lightest > 0.0:
+                self._idle_acceleration = self.force_scale(state) / lightest
         self.monitor.guard.start(*self.energy(state))
         self.store(0.0, state, with_contacts=False)
         mbs.SetPostStepUserFunction(self._post_step)
         if self.built.law_forces is not None and self.config.law_loads == "implicit":
             self._install_implicit_laws()
         if (self.built.law_forces is not None and self.config.law_loads == "explicit") or (
-                self.config.keep_jacobian and self.config.step_loop == "grid"):
+                self.config.keep_jacobian and self.config.step_loop == "grid") or \
+                self.idle is not None:
             mbs.SetPreStepUserFunction(self._pre_step)
         solver = exu.MainSolverImplicitSecondOrder()
         self._solver = solver
@@ -402,7 +420,8 @@ class Runner:
         return {"newton_iterations": int(solver.it.newtonStepsCount),
                 "jacobians": int(solver.it.newtonJacobiCount),
                 "discontinuous_iterations": int(solver.it.discontinuousIterationsCount),
-                "timers": {name: float(getattr(timer, name)) for name in TIMERS}}
+                "timers": {name: float(getattr(timer, name)) for name in TIMERS},
+                "idle_connectors": None if self.idle is None else self.idle.statistics()}
 
     def _read_failure(self, solver, simulation) -> None:
         """The failure's reason from the solver's flags (:mod:`.failure`; Exudyn's own error
