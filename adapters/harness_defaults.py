@@ -18,7 +18,9 @@ for the C-60, whose units are mm-g-ms).
 The C-60 step costs the engines declare (``c60_step_cost``) were measured by one ``clearbench
 demo`` on a 2-core machine (each engine's demo-plan c60-on runs, 4 ms of horizon, wall time per
 step over the reference's 1.35 ms per step at 1 us): MuJoCo tuned 0.32, PyBullet tuned 4.3,
-Drake tuned 9.6, Siconos 53 (at 10 us), Exudyn mechanism 98.
+Drake tuned 9.6, Siconos 53 (at 10 us); Exudyn mechanism 5.8 (the "x ref" column of the C-60
+table of a later ``clearbench demo``, its idle connectors switched off; 98 with every
+connector on).
 """
 
 from __future__ import annotations

@@ -51,8 +51,9 @@ MOTION_STEPS = 4.0
 
 #: Fewest connectors for which option 'auto' switches idle ones off: below it the check
 #: (tens of microseconds per step) costs more than Exudyn spends on the idle connectors
-#: (measured with tools/exudyn_idle_connectors.py on the library scenes: 8 connectors 1.3x
-#: slower, 74 connectors 0.9x, 208 and more 0.75x, the C-60's 1298 0.2x).
+#: (stepping time with / without, tools/exudyn_idle_connectors.py: 8 connectors 1.36, 74
+#: connectors 0.82, 208 and 288 connectors 0.62-0.70, the C-60's 1298 0.12;
+#: docs/engines/exudyn.md).
 MIN_CONNECTORS = 64
 
 #: Part of the margin below which an inactive connector counts as a breach (it closed more
