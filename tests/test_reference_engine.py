@@ -242,3 +242,19 @@ def test_flores_slider_crank_full_horizon(tmp_path):
     assert _figures(scene, trajectory, "no_penetration")["penetration_max"] <= 1e-9
     assert trajectory.solver_converged.all()
     assert not trajectory.unconverged_steps
+
+
+def test_the_activation_margin_option_reaches_the_stepper_and_defaults_to_the_scene_scale():
+    from clearbench.adapters.reference.settings import stepper_settings
+    from clearbench.scenarios.scales import feature_lengths
+
+    scene = get_scene("c60-on")
+    default = stepper_settings("default", scene, RunSettings())
+    # The default is 1e-10 of the smallest feature, computed from the same lengths: equal to
+    # round-off of one product.
+    assert default.activation_margin == pytest.approx(1e-10 * min(feature_lengths(scene)),
+                                                      rel=1e-15)
+    wider = stepper_settings("default", scene, RunSettings(options={"activation_margin": 1e-8}))
+    assert wider.activation_margin == 1e-8
+    with pytest.raises(ValueError, match="activation_margin"):
+        create("default").check_options({"activation_margin": 0.0})

@@ -12,11 +12,13 @@ Presets (each a separate engine variant in results):
 - ``implicit``: theta = 1 (more dissipative, unconditionally stable for stiff springs).
 
 Options (``RunSettings.options``) override: ``theta``, ``projection``, ``method``,
-``tolerance``, ``max_iterations``, ``position_tolerance``, ``restitution_threshold`` (default
-2 |g| h: slower impacts are plastic), ``joint_law`` (``midpoint`` or ``end``),
-``localise_impacts`` (true or false; every preset with the projection has it on: an impact
-with e > 0 is applied at its crossing time within the step instead of over the whole step,
-which takes the bouncing-ball apex errors at h = 1e-3 s from 8e-3 to 2e-5),
+``tolerance``, ``max_iterations``, ``position_tolerance``, ``activation_margin`` (default
+1e-10 x the smallest feature: contacts open by less at a step's start are active from its
+start), ``restitution_threshold`` (default 2 |g| h: slower impacts are plastic),
+``joint_law`` (``midpoint`` or ``end``), ``localise_impacts`` (true or false; every preset
+with the projection has it on: an impact with e > 0 is applied at its crossing time within the
+step instead of over the whole step, which takes the bouncing-ball apex errors at h = 1e-3 s
+from 8e-3 to 2e-5),
 ``roundoff_floor`` and ``step_loop`` (``auto``, ``python`` or ``compiled``:
 :mod:`.run`); see :class:`~clearbench.ref_solver.stepper.StepperSettings`.
 """
@@ -51,6 +53,7 @@ OPTIONS = OptionTable("reference", (
     number("tolerance", above=0.0),
     integer("max_iterations", at_least=1),
     number("position_tolerance", above=0.0),
+    number("activation_margin", above=0.0),
     number("restitution_threshold", at_least=0.0),
     choice("joint_law", ("midpoint", "end")),
     boolean("localise_impacts"),
@@ -89,7 +92,7 @@ def stepper_settings(preset: str, scene: Scene, settings: RunSettings) -> Steppe
         # 1e-10 of the smallest feature (a clearance, an offset, a radius): far below
         # anything the metrics resolve, far above round-off of positions.
         position_tolerance=float(options.get("position_tolerance", 1e-10 * smallest)),
-        activation_margin=1e-10 * smallest,
+        activation_margin=float(options.get("activation_margin", 1e-10 * smallest)),
         length_scale=largest,
         method=method,
         joint_law=str(options.get("joint_law", "midpoint")),
