@@ -95,6 +95,13 @@ class IdleConnectors:
         centre of mass [L]; 0 for bodies without connectors.
     active : (nc,) bool
         Current ``activeConnector`` of each connector.
+    switches, checks, active_sum : int, int, float
+        Connectors switched on or off, checks made (one per Exudyn step) and the sum of the
+        active counts over the checks (the mean active fraction of :meth:`statistics`).
+    margin_breaches, breach_examples : int, list of str
+        Breaches of the margin (module docstring) and the first five, described.
+    last_margin : float
+        The margin of the last check [L]; ``margins``: every finite margin so far [L].
     """
 
     objects: np.ndarray
