@@ -249,12 +249,16 @@ class Runner:
                 # calls continue one run, so the previous call's Jacobian is kept, as within
                 # one call (modified Newton updates it when it stops contracting).
                 solver.conv.jacobianUpdateRequested = False
-        if self.idle is not None:
-            self._switch_idle_connectors(mbs, t)
         laws = self.built.law_forces
-        if laws is None or self.config.law_loads != "explicit":
+        explicit_laws = laws is not None and self.config.law_loads == "explicit"
+        if self.idle is None and not explicit_laws:
             return True
-        position, _, rotation, _, _ = self.state()
+        state = self.state()  # read once for both uses below
+        if self.idle is not None:
+            self._switch_idle_connectors(mbs, t, state)
+        if not explicit_laws:
+            return True
+        position, _, rotation, _, _ = state
         com = position + np.einsum("bij,bj->bi", rotation, self.built.bodies.com)
         wrench = laws.wrenches(t, com, rotation)
         for b, force, torque in self.built.law_loads:
@@ -262,10 +266,10 @@ class Runner:
             mbs.SetLoadParameter(torque, "loadVector", wrench[b, 3:].tolist())
         return True
 
-    def _switch_idle_connectors(self, mbs, t: float) -> None:
+    def _switch_idle_connectors(self, mbs, t: float, state) -> None:
         """Switch the connectors that cannot touch within the margin off and the others on
-        for the coming step (:mod:`.idle_connectors`)."""
-        position, _, rotation, velocity, omega = self.state()
+        for the coming step (:mod:`.idle_connectors`); ``state`` as :meth:`state`."""
+        position, _, rotation, velocity, omega = state
         idle = self.idle
         margin = idle.margin(velocity, omega, self._idle_acceleration, self.dt)
         for index in idle.update(position, rotation, margin, t):
