@@ -1,4 +1,5 @@
-"""``clearbench bench c60|reference --against REV``: baseline export, worker protocol, ratio."""
+"""``clearbench bench c60|reference|engines --against REV``: baseline export, worker protocol,
+ratio."""
 
 from __future__ import annotations
 
@@ -26,13 +27,21 @@ def test_pair_keeps_the_best_run_of_each_side_and_their_ratio():
     assert pair.speedup == 2.0
 
 
-def test_unknown_revision_is_a_user_error(capsys):
-    assert main(["bench", "c60", "--against", "no-such-revision-anywhere"]) == 2
+def test_a_case_that_raised_on_a_side_has_an_error_and_no_ratio():
+    # e.g. a library scene the baseline revision does not have: reported, the others go on
+    pair = against.Pair(against.Case("new-scene"), [{"error": "KeyError: 'new-scene'"}], [])
+    assert pair.error == "baseline: KeyError: 'new-scene'"
+    assert against.Pair(against.Case("ball"), [_run()], [_run()]).error is None
+
+
+@pytest.mark.parametrize("benchmark", ["c60", "engines"])
+def test_unknown_revision_is_a_user_error(capsys, benchmark):
+    assert main(["bench", benchmark, "--against", "no-such-revision-anywhere"]) == 2
     assert "does not know the revision" in capsys.readouterr().err
 
 
-def test_against_applies_to_c60_and_reference_only(capsys):
-    # --against is an option of those two benchmarks only: argparse refuses it elsewhere
+def test_against_applies_to_c60_reference_and_engines_only(capsys):
+    # --against is an option of those three benchmarks only: argparse refuses it elsewhere
     with pytest.raises(SystemExit) as caught:
         main(["bench", "clearance-ladder", "--against", "HEAD"])
     assert caught.value.code == 2

@@ -285,3 +285,48 @@ def test_a_run_measured_against_a_reference_of_its_batch_starts_after_it(tmp_pat
         row = store.get(job.spec.key)
         assert row["recorded_utc"] >= reference["recorded_utc"]
         assert math.isfinite(row["error"]) and row["error"] > 0.0
+
+
+def test_a_warm_up_job_runs_first_for_its_engine_alone_and_is_not_stored(tmp_path):
+    # A warm-up (numba's cache filled by one worker) holds back every job of its engine until
+    # it ends, while the other worker runs another engine's job; it is neither stored nor
+    # counted. The warm-up sleeps 6 s: far longer than a fake run on the other worker (tenths
+    # of a second after its start-up), so the order below does not hang on the machine's speed.
+    from clearbench.harness.run.runner import RunJob
+
+    engines = {"fake": "tests.fake_engine", "other": "tests.fake_engine"}
+    warm_up = make_run_spec("torque-free-flip", "fake", horizon=0.002,
+                            options={"sleep": 6.0}, extra_engine_modules=engines,
+                            campaign="numba-warm-up")
+    gated = [make_run_spec("torque-free-flip", "fake", horizon=h, extra_engine_modules=engines)
+             for h in (0.1, 0.2)]
+    free = make_run_spec("torque-free-flip", "other", horizon=0.1, extra_engine_modules=engines)
+    finished = []
+    start = time.monotonic()
+    store = ResultsStore(tmp_path / "store")
+    outcome = Runner(store, jobs=2, on_finished=lambda done, total, spec, record: finished.append(
+        (spec.key, time.monotonic() - start, total))).run_all(
+        [RunJob(warm_up, warm_up=True), *gated, free])
+    assert sorted(outcome.ran) == sorted(s.key for s in (*gated, free))
+    assert len(store) == 3 and store.get(warm_up.key) is None
+    assert [total for _, _, total in finished] == [3, 3, 3]  # the warm-up is not counted
+    assert finished[0][0] == free.key  # it ran beside the warm-up
+    assert sorted(key for key, _, _ in finished[1:]) == sorted(s.key for s in gated)
+    for _, seconds, _ in finished[1:]:
+        assert seconds >= 6.0  # the fake engine's runs waited for the warm-up's 6 s sleep
+
+
+def test_warm_up_jobs_one_per_scene_preset_and_options_of_the_compiling_engines():
+    from clearbench.harness.run.numba_cache import WARM_UP_TIMEOUT, warm_up_jobs
+
+    engines = {"fake": "tests.fake_engine"}
+    specs = [make_run_spec("torque-free-flip", "fake", time_step=dt, extra_engine_modules=engines)
+             for dt in (1e-3, 2e-3)]
+    specs.append(make_run_spec("torque-free-flip", "fake", options={"bias": 1.0},
+                               extra_engine_modules=engines))
+    assert warm_up_jobs(specs, engines=("reference",)) == []
+    jobs = warm_up_jobs(specs, engines=("fake",))
+    assert len(jobs) == 2 and all(job.warm_up for job in jobs)  # two options, one scene
+    first = jobs[0].spec
+    assert first.horizon == 2 * first.time_step == 2e-3  # the first spec's step, two steps
+    assert first.timeout == WARM_UP_TIMEOUT and first.campaign == "numba-warm-up"

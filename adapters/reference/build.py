@@ -1,6 +1,6 @@
 """Building a reference run: the scene's array form, the stepper, the initial state and the
-compiled kernels (numba compiles on first use in a process, or loads its cache: compilation
-counts as building, never as stepping)."""
+compiled kernels of the loop that steps it (numba compiles on first use in a process, or loads
+its cache: compilation counts as building, never as stepping)."""
 
 from __future__ import annotations
 
@@ -30,15 +30,23 @@ class ReferenceModel:
     state: State
 
 
-def build(scene: Scene, config: StepperSettings) -> ReferenceModel:
-    """``scene`` as a :class:`ReferenceModel` stepped with ``config``, every kernel compiled
-    (one untimed step of a copy of the initial state)."""
+def build(scene: Scene, config: StepperSettings, python_step: bool = True) -> ReferenceModel:
+    """``scene`` as a :class:`ReferenceModel` stepped with ``config``; with ``python_step``
+    the Python step's kernels compiled (:func:`warm_python_step`). A run of the compiled loop
+    does not call them (it compiles its own: ``adapters.reference.run.choose_step_loop``)."""
     system = build_system(scene)
-    stepper = MoreauJeanStepper(system, config)
-    state = initial_state(scene)
+    model = ReferenceModel(system, MoreauJeanStepper(system, config), initial_state(scene))
+    if python_step:
+        warm_python_step(model)
+    return model
+
+
+def warm_python_step(model: ReferenceModel) -> None:
+    """Compile (or load) every kernel of the Python step (:meth:`MoreauJeanStepper.step`) for
+    ``model``: :func:`warm_up`, then one untimed step of a copy of its initial state by a
+    stepper of its own (the model's stepper and state are untouched)."""
     warm_up()
-    MoreauJeanStepper(system, config).step(state.copy())
-    return ReferenceModel(system, stepper, state)
+    MoreauJeanStepper(model.system, model.stepper.settings).step(model.state.copy())
 
 
 _WARM = False

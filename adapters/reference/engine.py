@@ -19,7 +19,7 @@ from clearbench.adapters.base import ModuleEngine, RunSettings
 from clearbench.adapters.options import OptionError
 from clearbench.adapters.recording import SampleRecorder, step_count
 from clearbench.adapters.reference import HARNESS_DEFAULTS, capabilities
-from clearbench.adapters.reference.build import build
+from clearbench.adapters.reference.build import build, warm_python_step
 from clearbench.adapters.reference.run import (
     RunStatistics,
     body_sample,
@@ -74,7 +74,7 @@ class ReferenceEngine(ModuleEngine):
     def _run(self, scene: Scene, settings: RunSettings) -> Trajectory:
         start = time.perf_counter()
         config = self.run_settings(scene, settings)
-        model = build(scene, config)
+        model = build(scene, config, python_step=False)
         stepper, state = model.stepper, model.state
         h = config.time_step
         steps = step_count(settings.horizon or scene.horizon, h)
@@ -84,6 +84,8 @@ class ReferenceEngine(ModuleEngine):
         statistics = RunStatistics(config.solver.tolerance)
         recorder.store(*body_sample(state, com))
         loop = choose_step_loop(settings.options.get("step_loop", "auto"), stepper)
+        if not loop.compiled:
+            warm_python_step(model)
         build_seconds = time.perf_counter() - start
         run = run_compiled if loop.compiled else run_python
         status, message, stepping, taken = run(stepper, state, steps, recorder, com, statistics)

@@ -89,6 +89,12 @@ def _engines_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--python-loop", action="store_true",
                         help="also run reference[default] with step_loop=python (the Python "
                         "step) beside the compiled loop")
+    parser.add_argument("--against", metavar="REV",
+                        help="instead of the engines: reference[default] on the baseline git "
+                        "revision REV and on this one, alternately in one session, and the "
+                        "speed-up per scene")
+    parser.add_argument("--repeat", type=int, default=2,
+                        help="--against: runs of each scene on each side (best one kept)")
 
 
 def _contenders(args: argparse.Namespace) -> list[engine_costs.Contender]:
@@ -119,6 +125,8 @@ def bench_engines(args: argparse.Namespace) -> int:
         raise UserError(f"--scene: unknown scene(s) {missing}; see `clearbench list`")
     if args.steps < 1:
         raise UserError(f"--steps must be >= 1, got {args.steps}")
+    if args.against:
+        return bench_against.run_engines_against(args, scenes)
     contenders = _contenders(args)
     reference = contenders[0].label
     print(f"Stepping cost per step [us] (stepping_seconds / steps of one run of at most "
@@ -419,7 +427,8 @@ BENCHMARKS: dict[str, Benchmark] = {
                      bench_c60, bench_against.add_arguments),
     "engines": Benchmark(
         "stepping cost per step of every engine[preset] on every library scene, side by "
-        "side, with the ratio to the reference", bench_engines, _engines_options),
+        "side, with the ratio to the reference (--against REV: the reference on a baseline "
+        "revision side by side)", bench_engines, _engines_options),
     "newton-first": Benchmark(
         "the hybrid solver with and without 'Newton first after a step that needed it' (c60-on)",
         bench_newton_first, _newton_first_options),

@@ -1,12 +1,14 @@
-"""``clearbench bench c60|reference --against REV``: a baseline revision and this one side by
-side, measured alternately in one session (:mod:`clearbench.harness.studies.against`)."""
+"""``clearbench bench c60|reference|engines --against REV``: a baseline revision and this one
+side by side, measured alternately in one session (:mod:`clearbench.harness.studies.against`)."""
 
 from __future__ import annotations
 
 import argparse
+import statistics
 
 from clearbench.harness.cli.common import UserError
 from clearbench.harness.studies.against import Case, resolve, side_by_side
+from clearbench.scenarios.library import get_scene
 
 #: Cases of each benchmark that supports ``--against``: (scene, factory parameters, horizon
 #: [scene time unit; None: the scene's]); every preset of ``--presets`` runs each.
@@ -31,13 +33,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scenes", nargs="+", help="--against: only these scenes")
 
 
-def run_against(args: argparse.Namespace) -> int:
+def _checked_baseline(args: argparse.Namespace) -> str:
+    """The full commit of ``--against`` (a UserError when git does not know it, or when
+    ``--repeat`` is below 1), before any run."""
     try:
         commit = resolve(args.against)
     except ValueError as error:
         raise UserError(str(error)) from error
     if args.repeat < 1:
         raise UserError(f"--repeat must be >= 1, got {args.repeat}")
+    return commit
+
+
+def run_against(args: argparse.Namespace) -> int:
+    commit = _checked_baseline(args)
     presets = args.presets or DEFAULT_PRESETS[args.benchmark]
     cases = [Case(scene, preset, args.horizon or horizon, parameters)
              for preset in presets for scene, parameters, horizon in CASES[args.benchmark]
@@ -50,6 +59,9 @@ def run_against(args: argparse.Namespace) -> int:
           f"{'iter/step b/t':>14}")
 
     def report(pair) -> None:
+        if pair.error:
+            print(f"{pair.case.scene:<19} {pair.case.preset:<8} {pair.error}", flush=True)
+            return
         b, c = pair.best_baseline, pair.best_current
         steps = c["steps"]
         print(f"{pair.case.scene:<19} {pair.case.preset:<8} {steps:>6} "
@@ -60,4 +72,40 @@ def run_against(args: argparse.Namespace) -> int:
               f"{b['mean_iterations']:>6.0f}/{c['mean_iterations']:<7.0f}", flush=True)
 
     side_by_side(cases, args.against, args.repeat, report)
+    return 0
+
+
+def run_engines_against(args: argparse.Namespace, scenes: list[str]) -> int:
+    """``bench engines --against REV``: the reference[default]'s stepping cost per step on each
+    of ``scenes`` (at most ``args.steps`` steps at the scene's time step), on the baseline
+    revision and on this one, alternately in one session."""
+    commit = _checked_baseline(args)
+    cases = []
+    for name in scenes:
+        scene = get_scene(name)
+        cases.append(Case(name, "default", min(scene.horizon, args.steps * scene.time_step)))
+    print(f"reference[default], baseline {args.against} ({commit[:10]}) and this revision, "
+          f"alternately in one session: stepping cost per step [us] of runs of at most "
+          f"{args.steps} steps (best of {args.repeat} on each side, after an untimed 20-step "
+          "warm-up), and the speed-up (baseline / this)")
+    print(f"{'scene':<27} {'steps':>6} {'base us/st':>11} {'this us/st':>11} {'speed-up':>8} "
+          f"{'unconv b/t':>11}")
+    speedups = []
+
+    def report(pair) -> None:
+        if pair.error:
+            print(f"{pair.case.scene:<27} {pair.error[:90]}", flush=True)
+            return
+        b, c = pair.best_baseline, pair.best_current
+        speedups.append(pair.speedup)
+        print(f"{pair.case.scene:<27} {c['steps']:>6} "
+              f"{1e6 * b['stepping_seconds'] / b['steps']:>11.1f} "
+              f"{1e6 * c['stepping_seconds'] / c['steps']:>11.1f} {pair.speedup:>8.2f} "
+              f"{b['unconverged_steps']:>5}/{c['unconverged_steps']:<5}", flush=True)
+
+    side_by_side(cases, args.against, args.repeat, report)
+    if speedups:
+        print(f"\nspeed-up over {len(speedups)} scenes: median "
+              f"{statistics.median(speedups):.3g}, range {min(speedups):.3g}-"
+              f"{max(speedups):.3g}")
     return 0

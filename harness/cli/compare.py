@@ -19,6 +19,7 @@ from clearbench.harness.cli.scenes import check_round_trip, print_engines
 from clearbench.harness.cli.sweep import print_work_precision
 from clearbench.harness.report.page import write_report
 from clearbench.harness.run.engine_choice import RunInputError, resolve_engine
+from clearbench.harness.run.numba_cache import warm_up_jobs
 from clearbench.harness.run.runner import MANY_RUNS_PER_WORKER
 from clearbench.harness.studies.c60_comparison import PLAN_NAMES
 from clearbench.harness.studies.stability import available_engines, plan_stability
@@ -123,9 +124,13 @@ def run_compare(args: argparse.Namespace) -> int:
     print(f"Comparing {labels} on {len(scenes)} scenes (ladder {args.dt}"
           + (", and the stiff suite" if stiff else "") + (", and the C-60" if c60 else "")
           + f"), store {store.directory}")
-    # One batch, the C-60's longest runs first: they run beside the scenes' short ones.
+    # One batch, the C-60's longest runs first: they run beside the scenes' short ones. Before
+    # them, one worker compiles the reference's kernels (two-step runs of its pending scenes)
+    # while the others run the other engines.
     runner = make_runner(args, store, len(c60) + len(plan.all_specs) + len(stiff))
-    outcome = execute_plan(plan, runner, before=c60)
+    stored = store.reusable_keys()
+    warm_up = warm_up_jobs([s for s in (*c60, *plan.all_specs, *stiff) if s.key not in stored])
+    outcome = execute_plan(plan, runner, before=[*warm_up, *c60])
     if stiff:
         more = runner.run_all(stiff)
         outcome.ran += more.ran

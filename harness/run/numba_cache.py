@@ -8,10 +8,11 @@ once into the cache (:func:`clearbench.numba_cache_dir`) that the suite's worker
 
 from __future__ import annotations
 
+import dataclasses
 import tempfile
 from collections.abc import Mapping, Sequence
 
-from clearbench.harness.run.runner import Runner, SweepOutcome
+from clearbench.harness.run.runner import RunJob, Runner, SweepOutcome
 from clearbench.harness.run.spec import RunSpec, make_run_spec
 from clearbench.harness.run.store import ResultsStore
 
@@ -53,3 +54,29 @@ def fill_cache(specs: Sequence[RunSpec], jobs: int = 1,
                         runs_per_worker=-(-len(specs) // max(1, jobs)),
                         environment=environment)
         return runner.run_all(list(specs), rerun=True)
+
+
+#: Engines whose first run in a fresh checkout compiles numba kernels for minutes (the
+#: reference solver's); :func:`warm_up_jobs` warms them up.
+COMPILING_ENGINES = ("reference",)
+
+
+def warm_up_jobs(specs: Sequence[RunSpec], engines: Sequence[str] = COMPILING_ENGINES
+                 ) -> list[RunJob]:
+    """Warm-up jobs (:class:`~clearbench.harness.run.runner.RunJob`, ``warm_up``) for a batch
+    of ``specs``: a two-step run of each distinct scene, preset and options that ``specs`` run
+    with one of ``engines``, the first scene of the batch first. Put before the batch, they make
+    one worker compile those engines' kernels (or load them, seconds when the cache is full)
+    while the other workers run the other engines' jobs."""
+    jobs, seen = [], set()
+    for spec in specs:
+        if spec.engine.name not in engines:
+            continue
+        identity = (spec.scene.content_hash, spec.engine.preset, spec.options)
+        if identity in seen:
+            continue
+        seen.add(identity)
+        jobs.append(RunJob(dataclasses.replace(
+            spec, horizon=min(spec.horizon, 2 * spec.time_step), record_every=1,
+            timeout=WARM_UP_TIMEOUT, campaign="numba-warm-up"), warm_up=True))
+    return jobs

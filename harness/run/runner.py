@@ -59,10 +59,15 @@ def default_jobs() -> int:
 
 @dataclass
 class RunJob:
-    """A spec to run, and the trajectory its error is measured against (if any)."""
+    """A spec to run, and the trajectory its error is measured against (if any).
+
+    A ``warm_up`` job fills numba's cache of its engine for the jobs after it: it is started
+    before any other job of its engine, one at a time, while the other workers run other
+    engines' jobs; its result is not stored nor counted (:meth:`Runner.run_all`)."""
 
     spec: RunSpec
     reference_key: str | None = None
+    warm_up: bool = False
 
 
 @dataclass
@@ -194,6 +199,10 @@ class Runner:
         (:data:`~.store.RERUN_STATUSES`; every job with ``rerun``).
 
         Jobs with the same key are run once. Returns what was run and what was skipped.
+        Warm-up jobs (:class:`RunJob`) run first for their engine, always, and are not stored:
+        from an empty cache one worker compiles an engine's kernels once, instead of every
+        worker compiling the same kernels side by side, and the other workers go on with
+        other engines' runs meanwhile.
         """
         outcome = SweepOutcome()
         queue: deque[RunJob] = deque()
@@ -205,7 +214,9 @@ class Runner:
             if key in seen:
                 continue
             seen.add(key)
-            if key in stored and not rerun:
+            if job.warm_up:
+                queue.append(job)
+            elif key in stored and not rerun:
                 outcome.skipped.append(key)
             else:
                 queue.append(job)
@@ -244,7 +255,7 @@ class Runner:
         slot.conn.send(request)
 
     def _loop(self, queue: deque, outcome: SweepOutcome, bar) -> None:
-        total = len(queue)
+        total = sum(not job.warm_up for job in queue)
         while queue or any(s.job is not None for s in self._slots):
             # fill idle slots
             while queue and (len(self._slots) < self.jobs
@@ -263,8 +274,11 @@ class Runner:
             handles = [s.conn for s in busy] + [s.process.sentinel for s in busy]
             multiprocessing.connection.wait(handles, timeout=min(wait_for, 1.0))
             for slot in busy:
+                job = slot.job
                 finished = self._service(slot)
-                if finished is not None:
+                if finished is not None and job.warm_up:
+                    self._finish_warm_up(slot, finished)
+                elif finished is not None:
                     record = self._finish(slot, finished, outcome)
                     if self.on_finished is not None:
                         self.on_finished(len(outcome.ran), total, finished.spec, record)
@@ -274,19 +288,40 @@ class Runner:
                                             refresh=False)
 
     def _next_ready(self, queue: deque) -> RunJob | None:
-        """Take out of ``queue`` the first job that may start: one whose reference run (the
-        trajectory its error is measured against) is not still queued or running in this
-        batch; None when every queued job waits for one that is running. So one batch may
-        hold fine references and the runs measured against them, in any order of workers."""
-        if queue[0].reference_key is None:
-            return queue.popleft()
-        running = [s.job.spec.key for s in self._slots if s.job is not None]
+        """Take out of ``queue`` the first job that may start: a warm-up job while no other
+        warm-up of its engine runs, else a job whose engine has no warm-up queued or running
+        and whose reference run (the trajectory its error is measured against) is not still
+        queued or running in this batch; None when every queued job waits for one that is
+        running. So one batch may hold warm-ups, fine references and the runs measured against
+        them, in any order of workers."""
+        running_jobs = [s.job for s in self._slots if s.job is not None]
+        warming = {job.spec.engine.name for job in running_jobs if job.warm_up}
+        gated = warming | {job.spec.engine.name for job in queue if job.warm_up}
+        running = [job.spec.key for job in running_jobs]
         waiting = {job.spec.key for job in queue}.union(running)
         for index, job in enumerate(queue):
-            if job.reference_key is None or job.reference_key not in waiting:
+            engine = job.spec.engine.name
+            if job.warm_up:
+                ready = engine not in warming
+            else:
+                ready = engine not in gated and (job.reference_key is None
+                                                 or job.reference_key not in waiting)
+            if ready:
                 del queue[index]
                 return job
         return None if running else queue.popleft()
+
+    def _finish_warm_up(self, slot: _Slot, finished: _Finished) -> None:
+        """A warm-up job is over: its worker goes on serving, its result is dropped (a
+        warm-up that failed is logged; the jobs it gated compile for themselves)."""
+        self._release(slot, finished)
+        tmp = finished.trajectory_tmp
+        if tmp is not None and tmp.exists():
+            tmp.unlink()
+        status = finished.ran.get("status")
+        if status != RunStatus.OK.value:
+            LOG.warning("warm-up %s: %s %s", finished.spec.label, status,
+                        finished.ran.get("message", ""))
 
     def _service(self, slot: _Slot):
         """Advance ``slot``; return a _Finished when its run is complete."""
@@ -335,13 +370,18 @@ class Runner:
         self._slots.remove(slot)
         return finished
 
-    def _finish(self, slot: _Slot, finished: _Finished, outcome: SweepOutcome) -> RunRecord:
-        spec = finished.spec
+    def _release(self, slot: _Slot, finished: _Finished) -> None:
+        """The slot of a finished job serves the next one, or its worker retires after
+        ``runs_per_worker`` runs (a worker that died was removed already)."""
         if finished.worker_ok:
             slot.job = None
             if slot.runs_done >= self.runs_per_worker:
                 self._retire(slot)
                 self._slots.remove(slot)
+
+    def _finish(self, slot: _Slot, finished: _Finished, outcome: SweepOutcome) -> RunRecord:
+        spec = finished.spec
+        self._release(slot, finished)
         record = RunRecord.from_worker(spec, finished.ran, finished.measured,
                                        self._revision, self._machine)
         tmp = finished.trajectory_tmp

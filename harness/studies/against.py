@@ -54,6 +54,16 @@ class Pair:
     baseline: list[dict]
     current: list[dict]
 
+    @property
+    def error(self) -> str | None:
+        """The first error a side reported for this case (a run that raised, e.g. on a scene
+        the baseline revision does not have), or None; a case with an error has no ratio."""
+        for side, runs in (("baseline", self.baseline), ("this revision", self.current)):
+            for run in runs:
+                if "error" in run:
+                    return f"{side}: {run['error']}"
+        return None
+
     @staticmethod
     def _best(runs: list[dict]) -> dict:
         return min(runs, key=lambda run: run["stepping_seconds"])
@@ -150,15 +160,14 @@ class _Worker:
                                         stdout=subprocess.PIPE, text=True, env=env)
 
     def measure(self, case: Case) -> dict:
+        """The worker's reply for ``case``: its measurement, or ``{"error": message}`` when
+        the case raised there (RuntimeError when the worker process ended)."""
         self.process.stdin.write(case.request())
         self.process.stdin.flush()
         line = self.process.stdout.readline()
         if not line:
             raise RuntimeError(f"worker ended before answering {case}")
-        reply = json.loads(line)
-        if "error" in reply:
-            raise RuntimeError(f"{case}: {reply['error']}")
-        return reply
+        return json.loads(line)
 
     def close(self) -> None:
         self.process.stdin.write("\n")
@@ -168,7 +177,8 @@ class _Worker:
 
 def side_by_side(cases: list[Case], revision: str, repeat: int = 2, report=None) -> list[Pair]:
     """Measure every case ``repeat`` times on the baseline ``revision`` and on this revision,
-    alternately, in one session; ``report(pair)`` is called as each case completes."""
+    alternately, in one session; ``report(pair)`` is called as each case completes. A case that
+    raises on either side is measured no further (its :attr:`Pair.error` says why)."""
     root = repository_root()
     python, env = baseline_environment(resolve(revision, root), root)
     baseline = _Worker(python, env)
@@ -181,6 +191,8 @@ def side_by_side(cases: list[Case], revision: str, repeat: int = 2, report=None)
                 order = (("baseline", baseline), ("current", current))
                 for side, worker in order if i % 2 == 0 else order[::-1]:
                     runs[side].append(worker.measure(case))
+                if any("error" in run for side_runs in runs.values() for run in side_runs):
+                    break
             pair = Pair(case, runs["baseline"], runs["current"])
             pairs.append(pair)
             if report is not None:

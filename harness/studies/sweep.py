@@ -122,10 +122,11 @@ def plan_sweep(scenes: Sequence[str | Scene], engines: Sequence[EngineChoice],
 
 
 def execute_plan(plan: SweepPlan, runner: Runner, rerun: bool = False,
-                 before: Sequence[RunSpec] = ()) -> SweepOutcome:
-    """Run ``before`` (runs of their own, started first: the longest of a batch), the fine
-    references and the sweep in one batch, skipping runs already stored; a run measured
-    against a fine reference starts once that reference is stored (:class:`Runner`)."""
+                 before: Sequence[RunSpec | RunJob] = ()) -> SweepOutcome:
+    """Run ``before`` (runs of their own, started first: warm-up jobs, the longest runs of a
+    batch), the fine references and the sweep in one batch, skipping runs already stored; a
+    run measured against a fine reference starts once that reference is stored
+    (:class:`Runner`)."""
     return runner.run_all([*before, *plan.references.values(), *plan.runs], rerun=rerun)
 
 
