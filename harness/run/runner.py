@@ -297,6 +297,10 @@ class Runner:
         running_jobs = [s.job for s in self._slots if s.job is not None]
         warming = {job.spec.engine.name for job in running_jobs if job.warm_up}
         gated = warming | {job.spec.engine.name for job in queue if job.warm_up}
+        first = queue[0]
+        if not first.warm_up and first.reference_key is None \
+                and first.spec.engine.name not in gated:
+            return queue.popleft()  # the common case, without hashing every queued key
         running = [job.spec.key for job in running_jobs]
         waiting = {job.spec.key for job in queue}.union(running)
         for index, job in enumerate(queue):
