@@ -129,7 +129,8 @@ def run_compare(args: argparse.Namespace) -> int:
     # while the others run the other engines.
     runner = make_runner(args, store, len(c60) + len(plan.all_specs) + len(stiff))
     stored = store.reusable_keys()
-    warm_up = warm_up_jobs([s for s in (*c60, *plan.all_specs, *stiff) if s.key not in stored])
+    warm_up = warm_up_jobs([s for s in (*c60, *plan.all_specs, *stiff) if s.key not in stored],
+                           extra_modules=modules)
     outcome = execute_plan(plan, runner, before=[*warm_up, *c60])
     if stiff:
         more = runner.run_all(stiff)

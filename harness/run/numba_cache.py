@@ -12,6 +12,7 @@ import dataclasses
 import tempfile
 from collections.abc import Mapping, Sequence
 
+from clearbench.harness.run.engine_choice import engine_defaults
 from clearbench.harness.run.runner import RunJob, Runner, SweepOutcome
 from clearbench.harness.run.spec import RunSpec, make_run_spec
 from clearbench.harness.run.store import ResultsStore
@@ -31,14 +32,16 @@ def reference_specs(scenes: Sequence[str], step_loops: Sequence[str] = STEP_LOOP
     """Two-step reference-engine runs of ``scenes`` (registered names) with each of
     ``step_loops``, interleaved by scene (scene 1 with each loop, then scene 2, ...) so that
     parallel workers compile different loops' kernels first."""
-    specs = []
-    for name in scenes:
-        for loop in step_loops:
-            spec = make_run_spec(name, "reference", options={"step_loop": loop})
-            specs.append(make_run_spec(name, "reference", horizon=2 * spec.time_step,
-                                       options={"step_loop": loop}, timeout=WARM_UP_TIMEOUT,
-                                       campaign="numba-warm-up"))
-    return specs
+    return [warm_up_spec(make_run_spec(name, "reference", options={"step_loop": loop}))
+            for name in scenes for loop in step_loops]
+
+
+def warm_up_spec(spec: RunSpec) -> RunSpec:
+    """``spec`` as a warm-up run: two steps (at most its horizon), a wall-clock limit long
+    enough to compile every kernel from an empty cache, campaign ``numba-warm-up``."""
+    return dataclasses.replace(spec, horizon=min(spec.horizon, 2 * spec.time_step),
+                               record_every=1, timeout=WARM_UP_TIMEOUT,
+                               campaign="numba-warm-up")
 
 
 def fill_cache(specs: Sequence[RunSpec], jobs: int = 1,
@@ -56,18 +59,18 @@ def fill_cache(specs: Sequence[RunSpec], jobs: int = 1,
         return runner.run_all(list(specs), rerun=True)
 
 
-#: Engines whose first run in a fresh checkout compiles numba kernels for minutes (the
-#: reference solver's); :func:`warm_up_jobs` warms them up.
-COMPILING_ENGINES = ("reference",)
-
-
-def warm_up_jobs(specs: Sequence[RunSpec], engines: Sequence[str] = COMPILING_ENGINES
-                 ) -> list[RunJob]:
+def warm_up_jobs(specs: Sequence[RunSpec], engines: Sequence[str] | None = None,
+                 extra_modules: Mapping[str, str] | None = None) -> list[RunJob]:
     """Warm-up jobs (:class:`~clearbench.harness.run.runner.RunJob`, ``warm_up``) for a batch
-    of ``specs``: a two-step run of each distinct scene, preset and options that ``specs`` run
-    with one of ``engines``, the first scene of the batch first. Put before the batch, they make
-    one worker compile those engines' kernels (or load them, seconds when the cache is full)
-    while the other workers run the other engines' jobs."""
+    of ``specs``: a two-step run (:func:`warm_up_spec`) of each distinct scene, preset and
+    options that ``specs`` run with one of ``engines`` (default: the engines that declare numba
+    kernels, ``HARNESS_DEFAULTS.numba``, plug-ins looked up in ``extra_modules``), the first
+    scene of the batch first. Put before the batch, they make one worker compile those engines'
+    kernels (or load them, seconds when the cache is full) while the other workers run the
+    other engines' jobs."""
+    if engines is None:
+        engines = {name for name in {spec.engine.name for spec in specs}
+                   if engine_defaults(name, extra_modules).numba}
     jobs, seen = [], set()
     for spec in specs:
         if spec.engine.name not in engines:
@@ -76,7 +79,5 @@ def warm_up_jobs(specs: Sequence[RunSpec], engines: Sequence[str] = COMPILING_EN
         if identity in seen:
             continue
         seen.add(identity)
-        jobs.append(RunJob(dataclasses.replace(
-            spec, horizon=min(spec.horizon, 2 * spec.time_step), record_every=1,
-            timeout=WARM_UP_TIMEOUT, campaign="numba-warm-up"), warm_up=True))
+        jobs.append(RunJob(warm_up_spec(spec), warm_up=True))
     return jobs
