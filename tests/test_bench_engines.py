@@ -34,3 +34,26 @@ def test_bench_engines_takes_an_engine_without_preset(capsys):
     rows = [line for line in capsys.readouterr().out.splitlines()
             if line.startswith("pendulum")]
     assert len(rows) == 1 and "reference[default]" in rows[0]
+
+
+def test_a_hanging_or_crashing_contender_is_a_row_and_the_benchmark_goes_on():
+    # Each run goes through the harness's isolated worker with a wall-clock limit: the fake
+    # engine's "hang" preset never returns and "segfault" kills its process. Both are rows with
+    # their status; the contender after them still runs in a fresh worker. The 3-s limit is far
+    # above a fake run (milliseconds after the worker's start-up) and far below a real hang.
+    from clearbench.harness.studies.benchmarks.engine_costs import Contender, measure
+
+    contenders = [Contender("fake", preset) for preset in ("default", "hang", "segfault",
+                                                           "default")]
+    costs = measure(["torque-free-flip"], contenders, steps=4, timeout=3.0,
+                    extra_engine_modules={"fake": "tests.fake_engine"})
+    assert [c.status for c in costs] == ["ok", "timed_out", "crashed", "ok"]
+    assert costs[1].message.startswith("warm-up:") and costs[1].seconds_per_step != \
+        costs[1].seconds_per_step  # NaN: no measured run after a warm-up that hung
+    assert costs[3].steps == 4 and costs[3].seconds_per_step > 0
+
+
+def test_bench_engines_against_refuses_the_contenders_options(capsys):
+    assert main(["bench", "engines", "--against", "HEAD", "--python-loop",
+                 "--scene", "pendulum"]) == 2
+    assert "--python-loop" in capsys.readouterr().err

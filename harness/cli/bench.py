@@ -17,8 +17,15 @@ from pathlib import Path
 
 from clearbench.adapters import siconos
 from clearbench.harness.cli import bench_against
-from clearbench.harness.cli.common import UserError, add_engine_option, assignments
+from clearbench.harness.cli.common import (
+    UserError,
+    add_engine_module_option,
+    add_engine_option,
+    assignments,
+    engine_modules,
+)
 from clearbench.harness.run.engine_choice import RunInputError, resolve_engine
+from clearbench.harness.run.spec import DEFAULT_TIMEOUT
 from clearbench.harness.studies.benchmarks import (
     clearance_ladder,
     contact_cost,
@@ -95,6 +102,10 @@ def _engines_options(parser: argparse.ArgumentParser) -> None:
                         "speed-up per scene")
     parser.add_argument("--repeat", type=int, default=2,
                         help="--against: runs of each scene on each side (best one kept)")
+    parser.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT, metavar="SECONDS",
+                        help="wall-clock limit of each run of a contender (its warm-up and its "
+                        f"measured run; default {DEFAULT_TIMEOUT:g})")
+    add_engine_module_option(parser)
 
 
 def _contenders(args: argparse.Namespace) -> list[engine_costs.Contender]:
@@ -104,7 +115,7 @@ def _contenders(args: argparse.Namespace) -> list[engine_costs.Contender]:
         contenders = []
         for label in args.engines:
             try:
-                choice = resolve_engine(label, field="--engine")
+                choice = resolve_engine(label, engine_modules(args), field="--engine")
             except RunInputError as error:
                 raise UserError(str(error)) from None
             contenders.append(engine_costs.Contender(choice.name, choice.preset))
@@ -125,13 +136,23 @@ def bench_engines(args: argparse.Namespace) -> int:
         raise UserError(f"--scene: unknown scene(s) {missing}; see `clearbench list`")
     if args.steps < 1:
         raise UserError(f"--steps must be >= 1, got {args.steps}")
+    if not args.timeout > 0:
+        raise UserError(f"--timeout must be > 0 [s], got {args.timeout}")
     if args.against:
+        ignored = [flag for flag, given in (
+            ("--engine", args.engines), ("--python-loop", args.python_loop),
+            ("--engine-module", args.engine_module),
+            ("--timeout", args.timeout != DEFAULT_TIMEOUT)) if given]
+        if ignored:
+            raise UserError(f"--against times reference[default] on two revisions; "
+                            f"{', '.join(ignored)} do not apply to it")
         return bench_against.run_engines_against(args, scenes)
     contenders = _contenders(args)
     reference = contenders[0].label
     print(f"Stepping cost per step [us] (stepping_seconds / steps of one run of at most "
           f"{args.steps} steps, after an untimed warm-up run), and its ratio to {reference}; "
-          "the contenders in turn on each scene, in one process")
+          "the contenders in turn on each scene, in one worker process, "
+          f"each run limited to {args.timeout:g} s")
     print(f"{'scene':<27} {'engine[preset]':<36} {'steps':>6} {'us/step':>10} "
           f"{'x ref':>8}  status")
     base: dict[str, float] = {}
@@ -144,7 +165,8 @@ def bench_engines(args: argparse.Namespace) -> int:
               f"{1e6 * cost.seconds_per_step:>10.1f} {ratio:>8.3g}  {cost.status}"
               + (f": {cost.message[:60]}" if cost.message else ""), flush=True)
 
-    costs = engine_costs.measure(scenes, contenders, args.steps, report)
+    costs = engine_costs.measure(scenes, contenders, args.steps, report, args.timeout,
+                                 engine_modules(args))
     ratios = engine_costs.ratios_to(costs, reference)
     print(f"\nPer contender, over the scenes both ran: median and largest ratio to {reference}")
     for contender in contenders[1:]:
