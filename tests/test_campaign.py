@@ -34,6 +34,7 @@ from clearbench.harness.studies.campaign.designs import sample_inputs, scene_par
 from clearbench.harness.studies.campaign.execution import (
     execute_run,
     plan_samples,
+    read_log,
     run_campaign,
 )
 from clearbench.harness.studies.campaign.report import (
@@ -316,8 +317,19 @@ def test_a_campaign_runs_on_a_local_cluster_resumes_and_reports(tmp_path):
     first = run_campaign(definition, store, workers=2)
     assert (first.planned, first.already, first.recorded) == (4, 0, 4)
     assert first.statuses == {"ok": 4}
+    # A kill -9 after the store's transaction and before the log's line (or in its middle):
+    # the last sample's line is cut. The next call runs nothing and logs that sample again,
+    # as recovered; the cut line is left out, and a new line never joins it.
+    log = store.directory / "campaigns" / "pendulum-test.jsonl"
+    lines = log.read_text().splitlines(keepends=True)
+    last = next(i for i in reversed(range(len(lines))) if '"event": "sample"' in lines[i])
+    lost = json.loads(lines[last])["key"]
+    log.write_text("".join(lines[:last]) + lines[last][:25])
     again = run_campaign(definition, store, workers=2)
     assert (again.already, again.recorded) == (4, 0)
+    entries = [e for e in read_log(log) if e.get("event") == "sample"]
+    assert sorted(e["key"] for e in entries) == sorted(store.keys())
+    assert [e["key"] for e in entries if e.get("recovered")] == [lost]
     more = run_campaign(with_overrides(definition, samples=6), store, workers=2)
     assert (more.already, more.recorded) == (4, 2)
     table = campaign_table(with_overrides(definition, samples=6), store)
@@ -329,7 +341,7 @@ def test_a_campaign_runs_on_a_local_cluster_resumes_and_reports(tmp_path):
     assert summary["outputs"][1]["capability"]["cpk"] is None   # no limits given
     for suffix in (".md", ".html", ".json", ".csv"):
         assert (tmp_path / "out" / f"pendulum-test{suffix}").exists()
-    assert summary["throughput"]["samples"] == 6
+    assert summary["throughput"]["samples"] == 6 and summary["throughput"]["recovered"] == 1
     # the comparison report carries the campaign's section, figures included
     paths = write_report(store, tmp_path / "report", c60_validation=None,
                          campaigns=tmp_path / "out")
@@ -354,8 +366,7 @@ def test_the_report_lists_a_study_before_the_companions_named_after_it(tmp_path)
 
 def recorded_keys(log: Path) -> list[str]:
     """Run keys of the samples a campaign's log records, in order."""
-    return [json.loads(line)["key"] for line in log.read_text().splitlines()
-            if json.loads(line).get("event") == "sample"]
+    return [entry["key"] for entry in read_log(log) if entry.get("event") == "sample"]
 
 
 def campaign_command(campaign: Path, store_dir: Path) -> list[str]:

@@ -19,6 +19,8 @@ workers repeatedly is recorded as a crashed run with Dask's message.
 
 Every recorded sample appends a line to ``<store>/campaigns/<name>.jsonl`` (sample index, key,
 status, wall times, completion time, session), from which the report takes samples per hour.
+The store comes first: a sample a killed client stored but did not log is logged by the next
+call, marked ``recovered`` (:meth:`CampaignLog.recover`).
 """
 
 from __future__ import annotations
@@ -190,15 +192,54 @@ class CampaignLog:
     def write(self, **entry) -> None:
         entry = {"session": self.session, "utc": datetime.now(UTC).isoformat(),
                  "elapsed_s": round(time.monotonic() - self.started, 3), **entry}
-        with self.path.open("a", encoding="utf-8") as stream:
-            stream.write(json.dumps(entry, sort_keys=True) + "\n")
+        line = (json.dumps(entry, sort_keys=True) + "\n").encode("utf-8")
+        with self.path.open("a+b") as stream:
+            end = stream.seek(0, 2)
+            # a session killed in the middle of a line left it unterminated: start a new one
+            if end and (stream.seek(end - 1), stream.read(1))[1] != b"\n":
+                line = b"\n" + line
+            stream.write(line)   # appended at the end whatever the read position
             stream.flush()
 
     def entries(self) -> list[dict]:
-        if not self.path.exists():
-            return []
-        lines = self.path.read_text(encoding="utf-8").splitlines()
-        return [json.loads(line) for line in lines if line.strip()]
+        """Every entry, in order; a line that is not JSON (cut by a kill) is left out."""
+        return read_log(self.path)
+
+    def recover(self, samples: list[CampaignSample], store: ResultsStore,
+                label: Callable[[CampaignSample], int | str]) -> int:
+        """Log the samples of this campaign that the store holds and the log lacks: a session
+        killed after storing a sample and before logging it (or in the middle of its line).
+        Their entries say ``recovered``: they count as samples, not in the rate (their
+        session's time is unknown). Returns how many were added."""
+        logged = {e.get("key") for e in self.entries() if e.get("event") == "sample"}
+        added = 0
+        for sample in samples:
+            if sample.spec.key in logged:
+                continue
+            row = store.get(sample.spec.key)
+            if row is None or row["campaign"] != sample.spec.campaign:
+                continue
+            self.write(event="sample", recovered=True, sample=label(sample), key=row["key"],
+                       status=row["status"], worker_seconds=row["worker_seconds"],
+                       stepping_seconds=row["stepping_seconds"])
+            added += 1
+        return added
+
+
+def read_log(path) -> list[dict]:
+    """The entries of a campaign log (JSON lines); a line that is not JSON, which only a kill
+    in the middle of a write leaves, is left out."""
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except FileNotFoundError:
+        return []
+    entries = []
+    for line in lines:
+        try:
+            entries.append(json.loads(line))
+        except json.JSONDecodeError:
+            continue
+    return entries
 
 
 @dataclass
@@ -269,6 +310,8 @@ def run_samples(definition: CampaignDefinition, samples: list[CampaignSample],
     outcome = CampaignProgress(planned=len(samples), already=len(samples) - len(todo),
                                statuses={})
     log = CampaignLog(store, definition.name)
+    name_of = label or (lambda sample: sample.index)
+    log.recover([s for s in samples if s.spec.key in stored], store, name_of)
     if not todo:
         return outcome
     cluster = plugins = None
@@ -302,7 +345,7 @@ def run_samples(definition: CampaignDefinition, samples: list[CampaignSample],
             record = _record(store, sample, result)
             outcome.recorded += 1
             outcome.statuses[record.status] = outcome.statuses.get(record.status, 0) + 1
-            log.write(event="sample", sample=label(sample) if label else sample.index,
+            log.write(event="sample", sample=name_of(sample),
                       key=record.key, status=record.status,
                       worker_seconds=record.worker_seconds,
                       stepping_seconds=record.stepping_seconds)

@@ -235,7 +235,10 @@ def _definition_lines(summary: dict) -> list[str]:
         f"statuses: {summary['statuses']}.",
         f"Inputs: {inputs}.",
         f"Throughput (campaign log): {speed['samples']} samples in {speed['sessions']} "
-        f"session(s), {_fmt(speed['samples_per_hour'], 3)} samples/hour with "
+        f"session(s)"
+        + (f" ({speed['recovered']} stored by a killed session before it logged them, "
+           "left out of the rate)" if speed.get("recovered") else "")
+        + f", {_fmt(speed['samples_per_hour'], 3)} samples/hour with "
         f"{speed['workers']} worker(s), median {_fmt(speed['worker_seconds_per_sample'], 3)} "
         f"s of worker time per sample; the paper's {PAPER_RUNS} runs would take "
         f"{_fmt(summary['projection_hours_for_paper_runs'], 3)} h here (the study: "

@@ -102,25 +102,31 @@ def campaign_table(definition: CampaignDefinition, store: ResultsStore, samples=
 
 def throughput(store: ResultsStore, definition: CampaignDefinition) -> dict:
     """Samples per hour and wall seconds per sample, from the campaign's own log: per session,
-    the samples it recorded over the time from its start to its last record."""
+    the samples it recorded over the time from its start to its last record. ``samples``
+    counts every logged sample; the rate leaves out the ``recovered`` ones (stored by a
+    session killed before it logged them: their time is unknown)."""
     entries = CampaignLog(store, definition.name).entries()
     sessions: dict[str, dict] = {}
+    recovered = 0
     for entry in entries:
         session = sessions.setdefault(entry["session"], {"samples": 0, "elapsed": 0.0,
                                                          "workers": None, "worker_seconds": []})
         if entry.get("event") == "start":
             session["workers"] = entry.get("workers")
+        elif entry.get("event") == "sample" and entry.get("recovered"):
+            recovered += 1
         elif entry.get("event") == "sample":
             session["samples"] += 1
             session["elapsed"] = max(session["elapsed"], entry["elapsed_s"])
             session["worker_seconds"].append(entry.get("worker_seconds", math.nan))
-    samples = sum(s["samples"] for s in sessions.values())
+    timed = sum(s["samples"] for s in sessions.values())
     elapsed = sum(s["elapsed"] for s in sessions.values())
     seconds = [x for s in sessions.values() for x in s["worker_seconds"] if x == x]
     workers = sorted({s["workers"] for s in sessions.values() if s["workers"]})
     return {
-        "sessions": len(sessions), "samples": samples, "wall_seconds": elapsed,
-        "samples_per_hour": 3600.0 * samples / elapsed if elapsed > 0 else math.nan,
+        "sessions": len(sessions), "samples": timed + recovered, "recovered": recovered,
+        "wall_seconds": elapsed,
+        "samples_per_hour": 3600.0 * timed / elapsed if elapsed > 0 else math.nan,
         "worker_seconds_per_sample": float(np.median(seconds)) if seconds else math.nan,
         "workers": workers,
     }
