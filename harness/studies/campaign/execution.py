@@ -195,9 +195,11 @@ class CampaignLog:
         line = (json.dumps(entry, sort_keys=True) + "\n").encode("utf-8")
         with self.path.open("a+b") as stream:
             end = stream.seek(0, 2)
-            # a session killed in the middle of a line left it unterminated: start a new one
-            if end and (stream.seek(end - 1), stream.read(1))[1] != b"\n":
-                line = b"\n" + line
+            if end:
+                # a session killed in the middle of a line left it unterminated: start anew
+                stream.seek(end - 1)
+                if stream.read(1) != b"\n":
+                    line = b"\n" + line
             stream.write(line)   # appended at the end whatever the read position
             stream.flush()
 

@@ -109,12 +109,13 @@ def throughput(store: ResultsStore, definition: CampaignDefinition) -> dict:
     sessions: dict[str, dict] = {}
     recovered = 0
     for entry in entries:
+        if entry.get("event") == "sample" and entry.get("recovered"):
+            recovered += 1   # not the session that logged it: it ran in a killed one
+            continue
         session = sessions.setdefault(entry["session"], {"samples": 0, "elapsed": 0.0,
                                                          "workers": None, "worker_seconds": []})
         if entry.get("event") == "start":
             session["workers"] = entry.get("workers")
-        elif entry.get("event") == "sample" and entry.get("recovered"):
-            recovered += 1
         elif entry.get("event") == "sample":
             session["samples"] += 1
             session["elapsed"] = max(session["elapsed"], entry["elapsed_s"])
