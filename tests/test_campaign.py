@@ -269,11 +269,91 @@ def test_sensitivities_find_the_driving_input_of_a_linear_response():
     rng = np.random.default_rng(3)
     x = rng.uniform(0, 1, (2000, 3))
     y = 3 * x[:, 0] + x[:, 1] + 0.01 * rng.normal(size=2000)
-    sens = sensitivities(x, y, ["a", "b", "c"], [(0, 1)] * 3, seed=1)
+    sens = sensitivities(x, y, ["a", "b", "c"], seed=1)
     assert sens.r_squared > 0.999
     assert sens.src[0] / sens.src[1] == pytest.approx(3.0, rel=0.05)
     assert abs(sens.src[2]) < 0.02
     assert np.argmax(sens.s1) == 0
+
+
+def test_first_order_indices_are_salibs_estimator_on_all_the_runs():
+    # SALib's delta.analyze takes its S1 on one bootstrap resample of the runs; the report's
+    # S1 is the same estimator on all of them, so it does not depend on the seed (which
+    # draws only the half-width's resamples). It is the between-class variance over SALib's
+    # equal-count classes of each input's rank (6 at 1,024 runs: ranks in (m_j, m_j+1],
+    # m = 0, 1024/6, ..), recomputed here; rel 1e-12: the same sums in another order.
+    rng = np.random.default_rng(5)
+    x = rng.standard_normal((1024, 3))
+    y = x @ np.array([1.0, 0.5, 0.0])
+    first = sensitivities(x, y, ["a", "b", "c"], seed=1)
+    second = sensitivities(x, y, ["a", "b", "c"], seed=2)
+    assert np.array_equal(first.s1, second.s1)
+    assert not np.array_equal(first.s1_confidence, second.s1_confidence)
+    edges = np.linspace(0.0, 1024.0, 7)
+    for i in range(3):
+        rank = np.argsort(np.argsort(x[:, i], kind="stable"), kind="stable") + 1
+        between = sum(np.count_nonzero(c) * (y[c].mean() - y.mean()) ** 2 for c in (
+            (rank > edges[j]) & (rank <= edges[j + 1]) for j in range(6))) / len(y)
+        assert first.s1[i] == pytest.approx(between / np.var(y), rel=1e-12)
+
+
+def test_an_input_that_does_nothing_keeps_the_grouping_floor_only():
+    # Under no effect the between-class share over 6 classes of 1,024 runs averages
+    # (6 - 1) / 1024 = 0.0049; on one bootstrap resample of the runs (delta.analyze's point
+    # estimate) the repeated rows double it (0.0100 measured over 200 such designs). Over 30
+    # designs the mean's standard error is 0.0005 (the share's sd 0.003 / sqrt(30)), so
+    # 0.0073 (0.0049 + 4 standard errors) separates the two.
+    rng = np.random.default_rng(11)
+    inactive = [sensitivities(x, x @ np.array([1.0, 0.7, 0.0]), ["a", "b", "c"], seed=k).s1[2]
+                for k, x in enumerate(rng.standard_normal((30, 1024, 3)))]
+    assert np.mean(inactive) < 0.0073
+
+
+def test_a_report_takes_the_runs_its_store_lacks_from_campaign_csvs(tmp_path):
+    # A campaign reported from its CSV (written by another revision, or on another machine)
+    # and an empty store: the same statistics as from the runs, each CSV used by the campaign
+    # whose design it matches (here the study and a plain Monte Carlo companion).
+    import pandas as pd
+
+    definition = parse_campaign(pendulum_campaign(samples=8))
+    companion = parse_campaign(pendulum_campaign(samples=4, design="monte-carlo",
+                                                 name="pendulum-mc"))
+
+    def csv_rows(campaign):
+        return pd.DataFrame([{
+            "sample": s.index, "key": f"{campaign.name}-{s.index}", "angle": s.inputs[0],
+            "length": s.inputs[1], "status": "ok", "message": "", "worker_seconds": 2.0,
+            "stepping_seconds": 1.0, "final_angle": 0.1 * s.index, "mean_x": 0.01 * s.index}
+            for s in plan_samples(campaign)])
+
+    ours, theirs = csv_rows(definition), csv_rows(companion)
+    store = ResultsStore(tmp_path / "store")
+    out = tmp_path / "out"
+    summary = write_campaign_report(definition, store, out, (companion,),
+                                    {"ours.csv": ours, "theirs.csv": theirs})
+    assert summary["sources"] == {"given": 8}
+    assert summary["outputs"][0]["capability"]["count"] == 8
+    assert summary["outputs"][0]["capability"]["mean"]["value"] == pytest.approx(0.35)
+    ours.to_csv(tmp_path / "ours.csv", index=False)
+    # the same file, keys included (those of the runs that computed the rows)
+    assert (out / "pendulum-test.csv").read_text() == (tmp_path / "ours.csv").read_text()
+    assert "Runs by source: {'given': 8}" in (out / "pendulum-test.md").read_text()
+    # a CSV of neither campaign is refused by name; one with a sample's inputs changed, by
+    # that sample
+    other = ours.assign(angle=ours["angle"] + 0.01)
+    with pytest.raises(CampaignError) as error:
+        write_campaign_report(definition, store, out, given={"other.csv": other})
+    assert error.value.field == "given other.csv"
+    changed = ours.copy()
+    changed.loc[2, "angle"] *= 1.01
+    with pytest.raises(CampaignError) as error:
+        write_campaign_report(definition, store, out, given={"changed.csv": changed})
+    assert "sample 2" in error.value.field
+    # the command names the CSV
+    campaign = write_campaign(tmp_path, pendulum_campaign(samples=8))
+    other.to_csv(tmp_path / "other.csv", index=False)
+    assert main(["campaign", "report", str(campaign), "--store", str(tmp_path / "store"),
+                 "--out", str(out), "--given", str(tmp_path / "other.csv")]) == 2
 
 
 def test_collect_takes_the_statistic_over_the_last_window():

@@ -81,7 +81,11 @@ def register(subparsers) -> None:
     report.add_argument("--against", default=None, metavar="NAME",
                         help="metamodel campaigns: a sampling campaign whose report is in the "
                         "output folder, shown side by side")
-    _add_given_option(report)
+    report.add_argument("--given", default=[], action="append", metavar="CSV",
+                        help="runs the store lacks, taken from a campaign's CSV (written by "
+                        "'campaign report', maybe by another revision of the code) for the "
+                        "samples it holds with the same inputs; repeatable for the --with "
+                        "campaigns (a metamodel campaign takes one)")
     report.set_defaults(handler=_report)
 
     status = commands.add_parser("status", help="recorded samples by status")
@@ -107,18 +111,26 @@ def _add_given_option(parser: argparse.ArgumentParser) -> None:
 
 
 def _given(args: argparse.Namespace):
-    if not getattr(args, "given", None):
-        return None
+    """The ``--given`` CSV as a DataFrame (None without one); a metamodel campaign's report
+    takes at most one."""
+    given = getattr(args, "given", None)
+    if isinstance(given, list):
+        if len(given) > 1:
+            raise UserError(f"--given {given[1]}: a metamodel campaign takes one CSV")
+        given = given[0] if given else None
+    return None if not given else _read_given(given)
+
+
+def _read_given(text: str):
     import pandas as pd  # lazily, as the results store does
 
-    path = Path(args.given)
     try:
-        table = pd.read_csv(path)
+        table = pd.read_csv(Path(text))
     except (OSError, ValueError) as error:
-        raise UserError(f"--given {args.given}: {error}") from None
+        raise UserError(f"--given {text}: {error}") from None
     missing = {"sample", "status", "message"} - set(table.columns)
     if missing:
-        raise UserError(f"--given {args.given}: not a campaign CSV (no column "
+        raise UserError(f"--given {text}: not a campaign CSV (no column "
                         f"{sorted(missing)[0]!r})")
     return table
 
@@ -163,11 +175,14 @@ def _run(args: argparse.Namespace) -> int:
 def _report(args: argparse.Namespace) -> int:
     definition = _definition(args)
     companions = tuple(_definition(args, text) for text in args.companions)
-    store = open_store(args, create=False)
+    # runs given from CSVs need no store of runs: an empty one is made (the campaign's log,
+    # for the throughput, is read from it)
+    store = open_store(args, create=bool(args.given))
     if definition.method == "metamodel":
         return _metamodel_report(args, definition, store)
+    given = {text: _read_given(text) for text in args.given}
     try:
-        summary = write_campaign_report(definition, store, Path(args.out), companions)
+        summary = write_campaign_report(definition, store, Path(args.out), companions, given)
     except CampaignError as error:
         raise UserError(f"{args.campaign}: {error}") from None
     print(f"{definition.name}: {summary['statuses']}; report in {args.out}/"

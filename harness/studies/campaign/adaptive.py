@@ -55,12 +55,10 @@ from clearbench.harness.studies.campaign.rare_events import (
     failure_probability,
     ray_factors,
 )
-from clearbench.harness.studies.campaign.results import campaign_table
+from clearbench.harness.studies.campaign.results import campaign_table, take_given
 
 #: Index of the first confirmation run (design samples stay below it).
 CONFIRMATION_START = 10_000_000
-#: Relative tolerance on the inputs of a given row against the design's.
-GIVEN_TOLERANCE = 1e-9
 
 
 def state_path(store: ResultsStore, definition: CampaignDefinition):
@@ -90,23 +88,8 @@ def design_table(definition: CampaignDefinition, store: ResultsStore, count: int
     samples = plan_samples(definition, 0, count)
     table = campaign_table(definition, store, samples)
     table["source"] = np.where(table["status"] == "pending", "pending", "store")
-    if given is None:
-        return table
-    names = [law.name for law in definition.inputs]
-    outputs = [o.name for o in definition.outputs]
-    indexed = given.set_index("sample")
-    for row in table.index[table["status"] == "pending"]:
-        sample = int(table.at[row, "sample"])
-        if sample not in indexed.index:
-            continue
-        theirs = indexed.loc[sample, names].to_numpy(float)
-        ours = table.loc[row, names].to_numpy(float)
-        if not np.allclose(theirs, ours, rtol=GIVEN_TOLERANCE, atol=0.0):
-            raise CampaignError(f"given runs, sample {sample}", theirs.tolist(),
-                                f"inputs differ from this design's {ours.tolist()}")
-        for column in ["status", "message"] + outputs:
-            table.at[row, column] = indexed.at[sample, column]
-        table.at[row, "source"] = "given"
+    if given is not None:
+        take_given(definition, table, given)
     return table
 
 

@@ -123,7 +123,7 @@ def sobol_figure(entry: dict, inputs: list[str], against: dict | None) -> bytes:
     if against and against.get("s1"):
         ax.bar(positions + 0.25, against["s1"], width=0.25, yerr=against["s1_confidence"],
                capsize=2, color="#d95f02",
-               label=f"S1, {against['count']} runs (SALib delta)")
+               label=f"S1, {against['count']} runs (given data)")
     ax.set_xticks(positions, inputs)
     ax.set_ylabel("share of the variance")
     ax.set_title(f"{entry['name']}: Sobol' indices (95 % intervals)", fontsize=9)

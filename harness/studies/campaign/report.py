@@ -19,11 +19,11 @@ from scipy import stats
 
 from clearbench.harness.report.figures import _png, _pyplot
 from clearbench.harness.run.store import ResultsStore
-from clearbench.harness.studies.campaign.definition import CampaignDefinition
+from clearbench.harness.studies.campaign.definition import CampaignDefinition, CampaignError
 from clearbench.harness.studies.campaign.formatting import format_number as _fmt
 from clearbench.harness.studies.campaign.results import (
-    campaign_table,
     definition_summary,
+    report_table,
     throughput,
 )
 from clearbench.harness.studies.campaign.statistics import (
@@ -49,9 +49,13 @@ def _interval(value, digits: int = 4) -> str:
 
 
 def summarise(definition: CampaignDefinition, store: ResultsStore,
-              companions: tuple[CampaignDefinition, ...] = ()) -> dict:
-    """Everything the section shows, as plain data (also written as JSON)."""
-    table = campaign_table(definition, store)
+              companions: tuple[CampaignDefinition, ...] = (), given=(),
+              table=None) -> dict:
+    """Everything the section shows, as plain data (also written as JSON); the runs from the
+    store, and the samples it lacks from the campaign CSVs ``given`` (DataFrames) that hold
+    them (:func:`report_table`), unless ``table`` is that table already."""
+    if table is None:
+        table, _ = report_table(definition, store, given)
     ok = table[table["status"] == "ok"]
     statuses = table["status"].value_counts().to_dict()
     outputs = []
@@ -73,7 +77,6 @@ def summarise(definition: CampaignDefinition, store: ResultsStore,
         if len(ok) > definition.dimension + 2:
             sens = sensitivities(ok[[law.name for law in definition.inputs]].to_numpy(),
                                  values, [law.name for law in definition.inputs],
-                                 [(law.lower, law.upper) for law in definition.inputs],
                                  seed=definition.seed)
             entry["sensitivity"] = {"inputs": list(sens.names),
                                     "src": sens.src.tolist(), "r_squared": sens.r_squared,
@@ -87,6 +90,7 @@ def summarise(definition: CampaignDefinition, store: ResultsStore,
     return {
         "definition": definition_summary(definition),
         "samples_planned": int(len(table)), "statuses": statuses,
+        "sources": {str(k): int(v) for k, v in table["source"].value_counts().items()},
         "not_ok": table[~table["status"].isin(["ok", "pending"])][
             ["sample", "key", "status", "message"]].to_dict("records"),
         "outputs": outputs, "throughput": speed,
@@ -155,17 +159,29 @@ def convergence_figure(name: str, unit: str, series: dict[str, np.ndarray]) -> b
 # ---------------------------------------------------------------------- writing
 def write_campaign_report(definition: CampaignDefinition, store: ResultsStore,
                           out_dir: str | Path,
-                          companions: tuple[CampaignDefinition, ...] = ()) -> dict:
-    """Write ``<name>.md``, ``<name>.html``, ``<name>.json`` and figures under ``out_dir``;
-    ``companions`` are campaigns of the same study with other designs, drawn in the
-    convergence figures. Returns the summary."""
+                          companions: tuple[CampaignDefinition, ...] = (),
+                          given: dict | None = None) -> dict:
+    """Write ``<name>.md``, ``<name>.html``, ``<name>.json``, ``<name>.csv`` and figures
+    under ``out_dir``; ``companions`` are campaigns of the same study with other designs,
+    drawn in the convergence figures; ``given`` maps a name (the CSV's path) to a campaign
+    CSV's DataFrame that supplies runs the store lacks, for this campaign or a companion
+    (each must supply some). Returns the summary."""
+    frames = tuple((given or {}).values())
+    table, filled = report_table(definition, store, frames)
+    others = {}
+    for companion in companions:
+        others[companion.design + f" ({companion.name})"], theirs = report_table(
+            companion, store, frames)
+        filled = [a + b for a, b in zip(filled, theirs, strict=True)]
+    for name, frame, count in zip(given or {}, frames, filled, strict=True):
+        if count == 0:
+            raise CampaignError(f"given {name}", f"{len(frame)} rows", "none is a pending "
+                                "sample of this report's campaigns with the same inputs")
     out = Path(out_dir)
     figures_dir = out / "figures"
     figures_dir.mkdir(parents=True, exist_ok=True)
-    summary = summarise(definition, store, companions)
-    table = campaign_table(definition, store)
+    summary = summarise(definition, store, companions, table=table)
     ok = table[table["status"] == "ok"]
-    others = {c.design + f" ({c.name})": campaign_table(c, store) for c in companions}
     pngs: dict[str, bytes] = {}
     for spec, entry in zip(definition.outputs, summary["outputs"], strict=True):
         values = ok[spec.name].to_numpy(dtype=float)
@@ -184,7 +200,7 @@ def write_campaign_report(definition: CampaignDefinition, store: ResultsStore,
     markdown = render_markdown(summary, list(pngs))
     (out / f"{definition.name}.md").write_text(markdown, encoding="utf-8")
     (out / f"{definition.name}.html").write_text(render_html(summary, pngs), encoding="utf-8")
-    table.to_csv(out / f"{definition.name}.csv", index=False)
+    table.drop(columns="source").to_csv(out / f"{definition.name}.csv", index=False)
     return summary
 
 
@@ -232,7 +248,9 @@ def _definition_lines(summary: dict) -> list[str]:
     return [
         f"Scene `{d['scene']}` {d['scene_parameters'] or ''} in `{d['engine']}`, design "
         f"`{d['design']}`, seed {d['seed']}, {summary['samples_planned']} samples planned; "
-        f"statuses: {summary['statuses']}.",
+        f"statuses: {summary['statuses']}."
+        + (f" Runs by source: {summary['sources']} (given: taken from a campaign CSV)."
+           if summary.get("sources", {}).get("given") else ""),
         f"Inputs: {inputs}.",
         f"Throughput (campaign log): {speed['samples']} samples in {speed['sessions']} "
         f"session(s)"
@@ -278,7 +296,8 @@ def _sensitivity_markdown(summary: dict) -> list[str]:
         return []
     names = entries[0]["sensitivity"]["inputs"]
     lines = ["Sensitivities: standardised regression coefficients (SRC, with the linear fit's "
-             "R^2) and SALib's first-order index S1 (delta method, given data) per input.", "",
+             "R^2) and the first-order index S1 (given data: SALib's delta-method estimator on all "
+             "the runs) per input.", "",
              "| output | R^2 | " + " | ".join(f"{n} SRC / S1" for n in names) + " |",
              "|" + "---|" * (len(names) + 2)]
     for entry in entries:

@@ -18,8 +18,18 @@ import numpy as np
 import clearbench
 from clearbench.harness.measure.series import output_values
 from clearbench.harness.run.store import ResultsStore
-from clearbench.harness.studies.campaign.definition import CampaignDefinition, OutputSpec
+from clearbench.harness.studies.campaign.definition import (
+    CampaignDefinition,
+    CampaignError,
+    OutputSpec,
+)
 from clearbench.harness.studies.campaign.execution import CampaignLog, plan_samples
+
+#: Relative tolerance on the inputs of a given row against the design's.
+GIVEN_TOLERANCE = 1e-9
+#: The columns a given row brings, beside the outputs, where the CSV has them (its run key:
+#: the run that computed it, maybe by another revision of the code).
+GIVEN_COLUMNS = ("key", "status", "message", "worker_seconds", "stepping_seconds")
 
 
 def collect(spec: OutputSpec, times: np.ndarray, values: np.ndarray) -> float:
@@ -140,3 +150,57 @@ def definition_summary(definition: CampaignDefinition) -> dict:
             "seed": definition.seed, "scene_parameters": dict(definition.scene_parameters),
             "inputs": [asdict(law) for law in definition.inputs],
             "outputs": [asdict(o) for o in definition.outputs]}
+
+
+def take_given(definition: CampaignDefinition, table, given, strict: bool = True) -> int:
+    """Fill the pending rows of ``table`` (:func:`campaign_table`'s, with a ``source``
+    column, changed in place) from ``given`` (a campaign CSV's DataFrame, maybe written by
+    another revision of the code or on another machine): run key, status, message, timings,
+    inputs and outputs of every pending sample whose index ``given`` holds with the same
+    inputs (to :data:`GIVEN_TOLERANCE`); those rows' source becomes ``given``. Returns how
+    many rows were filled.
+
+    Raises :class:`CampaignError` naming the sample when ``given`` holds a pending sample with
+    other inputs, or the column it lacks, unless ``strict`` is False and it lacks a column or
+    none of its shared samples match (then it is another campaign's CSV: nothing is taken).
+    """
+    names = [law.name for law in definition.inputs]
+    columns = [c for c in GIVEN_COLUMNS if c in given.columns] + [
+        o.name for o in definition.outputs]
+    missing = sorted(set(names + columns) - set(given.columns))
+    if missing and not strict:
+        return 0   # without this campaign's inputs or outputs: another campaign's CSV
+    if missing:
+        raise CampaignError("given runs", missing[0], "no such column in the CSV")
+    indexed = given.set_index("sample")
+    pending = [row for row in table.index[table["status"] == "pending"]
+               if int(table.at[row, "sample"]) in indexed.index]
+    differing = [row for row in pending if not np.allclose(
+        indexed.loc[int(table.at[row, "sample"]), names].to_numpy(float),
+        table.loc[row, names].to_numpy(float), rtol=GIVEN_TOLERANCE, atol=0.0)]
+    if differing and (strict or len(differing) < len(pending)):
+        row = differing[0]
+        sample = int(table.at[row, "sample"])
+        raise CampaignError(f"given runs, sample {sample}",
+                            indexed.loc[sample, names].to_numpy(float).tolist(),
+                            f"inputs differ from this design's "
+                            f"{table.loc[row, names].to_numpy(float).tolist()}")
+    if differing:
+        return 0
+    for row in pending:
+        sample = int(table.at[row, "sample"])
+        for column in columns + names:   # the inputs as the run had them (within tolerance)
+            table.at[row, column] = indexed.at[sample, column]
+        table.at[row, "source"] = "given"
+    return len(pending)
+
+
+def report_table(definition: CampaignDefinition, store: ResultsStore, given=()):
+    """:func:`campaign_table` with a ``source`` column (``store``, ``given`` or ``pending``),
+    its pending samples taken from each of the campaign CSVs ``given`` (DataFrames) that holds
+    them with this design's inputs (:func:`take_given`; another campaign's CSV is passed
+    over). Returns the table and how many rows each CSV filled."""
+    table = campaign_table(definition, store)
+    table["source"] = np.where(table["status"] == "pending", "pending", "store")
+    filled = [take_given(definition, table, frame, strict=False) for frame in given]
+    return table, filled
