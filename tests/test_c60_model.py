@@ -256,6 +256,28 @@ def test_outputs_in_the_on_pose_are_the_measurement_distances():
     assert occ["Mcontact_Magnetic_FC_X"] == pytest.approx(9.434, abs=1e-3)
 
 
+def test_measurement_points_are_searched_once_per_pose_and_equal_a_fresh_search():
+    # The 7 measurement points depend on the ON poses only, not on the clearances: two scenes
+    # with other clearances search none again, and a cached point is the fresh search's, bit
+    # for bit (so the scenes, and their content hashes, are those of an uncached build).
+    model._nearest_point_searched.cache_clear()
+    first = get_scene("c60-on")
+    searched = model._nearest_point_searched.cache_info().misses
+    second = get_scene("c60-on", clearances={"J2": 0.05, "J5": 0.08})
+    assert model._nearest_point_searched.cache_info().misses == searched == 7
+    assert [o for o in first.outputs if o.name != "FC1_contact_force"] == [
+        o for o in second.outputs if o.name != "FC1_contact_force"]
+    measurement = model.load_model()["measurements"][0]
+    pose = model.on_poses()[measurement["body1"]]
+    key = (measurement["cad1"], measurement["cad2"], pose.position.tobytes(),
+           pose.quaternion.tobytes())
+    cached = model._nearest_point(measurement["cad1"], measurement["cad2"], pose)
+    assert tuple(cached) == model._nearest_point_searched.__wrapped__(*key)
+    cached[0] += 1.0      # a caller's copy: the cache keeps its own
+    assert tuple(model._nearest_point(measurement["cad1"], measurement["cad2"], pose)) == \
+        model._nearest_point_searched.__wrapped__(*key)
+
+
 def test_twist_angle_differs_from_the_source_angle_at_second_order_in_the_tilt():
     from clearbench.kernels.quaternion import quat_from_axis_angle, quat_multiply, quat_to_matrix
     from clearbench.ref_solver.forces import twist_angle

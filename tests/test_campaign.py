@@ -368,6 +368,27 @@ def test_collect_takes_the_statistic_over_the_last_window():
 
 
 # ---------------------------------------------------------------------- running on Dask
+def test_a_run_keyed_by_other_sources_stops_the_campaign_by_name(tmp_path):
+    # A worker that runs other sources (edited while the campaign ran, or another checkout
+    # behind a remote scheduler) keys its run otherwise: the client stores it under that key
+    # and stops with the sample named, rather than wait for a key that never comes.
+    from dataclasses import asdict
+
+    from clearbench.harness.run.store import RunRecord, machine_info, revision_info
+
+    sample = plan_samples(parse_campaign(pendulum_campaign()))[0]
+    row = asdict(RunRecord.from_worker(sample.spec, {"status": "ok", "message": ""}, {},
+                                       revision_info(), machine_info()))
+    store = ResultsStore(tmp_path / "store")
+    assert execution._record(store, sample, {"row": row, "trajectory": None}).key == \
+        sample.spec.key
+    other = dict(row, key="0" * 24)
+    with pytest.raises(CampaignError) as error:
+        execution._record(store, sample, {"row": other, "trajectory": None})
+    assert error.value.field == "sample 0" and "other sources" in error.value.reason
+    assert store.keys() == {sample.spec.key, "0" * 24}
+
+
 def test_a_dask_worker_keeps_its_run_process_warm_between_samples():
     # execute_run is what a Dask task calls: with runs_per_worker = 2 the first two samples
     # run in one process, which is then replaced; each sample's row is that of a fresh process

@@ -540,7 +540,22 @@ FUNCTIONAL_CONDITIONS = {
 
 
 def _nearest_point(body_file: str, plane_file: str, pose: Pose) -> np.ndarray:
-    """Point (body frame) of a body feature nearest a world plane in the ON pose."""
+    """Point (body frame) [mm] of a body feature nearest a world plane in the ON pose, (3,).
+
+    Every scene of a campaign asks the same few (7 measurements, one pose each), and a search
+    goes over thousands of candidate points; so each is searched once per process.
+    """
+    position = np.asarray(pose.position, dtype=float).tobytes()
+    quaternion = np.asarray(pose.quaternion, dtype=float).tobytes()
+    return np.array(_nearest_point_searched(body_file, plane_file, position, quaternion))
+
+
+@lru_cache(maxsize=256)
+def _nearest_point_searched(body_file: str, plane_file: str, position: bytes,
+                            quaternion: bytes) -> tuple[float, float, float]:
+    """:func:`_nearest_point` for the pose whose position and quaternion (float64) are the
+    bytes given: the candidates on the feature, the nearest by a search over all of them."""
+    pose = Pose(np.frombuffer(position), np.frombuffer(quaternion))
     plane = primitives()[plane_file].primitives[0]
     normal = np.asarray(plane.normal, dtype=float)
     origin = np.asarray(plane.point, dtype=float)
@@ -564,7 +579,7 @@ def _nearest_point(body_file: str, plane_file: str, pose: Pose) -> np.ndarray:
                                       + corner_u * np.asarray(primitive.u_axis)
                                       + corner_v * np.asarray(primitive.v_axis))
     distances = [abs((pose.point(c) - origin) @ normal) for c in candidates]
-    return candidates[int(np.argmin(distances))]
+    return tuple(float(x) for x in candidates[int(np.argmin(distances))])
 
 
 def c60_outputs(poses: Mapping[str, Pose]) -> list[Output]:

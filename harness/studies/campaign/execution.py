@@ -255,16 +255,33 @@ class CampaignProgress:
 
 
 def _record(store: ResultsStore, sample: CampaignSample, result: dict) -> RunRecord:
+    """Store a worker's ``result`` for ``sample``.
+
+    Raises
+    ------
+    CampaignError
+        The worker keyed the run otherwise than this client: it ran other sources (edited
+        while the campaign ran, or another checkout on a remote worker). Its run is stored
+        under its own key (a run of those sources), but this campaign cannot count it: left
+        unchecked, the client would wait for a key that never comes (a resumed campaign runs
+        the sample again and again; a metamodel's confirmation run stays pending).
+    """
     row = dict(result["row"])
     row.pop("trajectory", None)
     record = RunRecord(**row, trajectory="")
     trajectory = None
     if result.get("trajectory") is not None:
-        trajectory = store.trajectory_dir / f".{sample.spec.key}.campaign.tmp.npz"
+        trajectory = store.trajectory_dir / f".{record.key}.campaign.tmp.npz"
         trajectory.write_bytes(result["trajectory"])
     store.record(record, trajectory_file=trajectory, scene=sample.spec.scene)
     if trajectory is not None:
         trajectory.unlink(missing_ok=True)
+    if record.key != sample.spec.key:
+        raise CampaignError(f"sample {sample.index}", record.key,
+                            f"the worker's run key differs from this client's "
+                            f"{sample.spec.key}: the worker runs other sources (edited while "
+                            "the campaign ran, or another checkout); run every worker and the "
+                            "client from one state of the code")
     return record
 
 
