@@ -55,7 +55,7 @@ from clearbench.harness.studies.campaign.rare_events import (
     failure_probability,
     ray_factors,
 )
-from clearbench.harness.studies.campaign.results import campaign_table, take_given
+from clearbench.harness.studies.campaign.results import campaign_table, report_table
 
 #: Index of the first confirmation run (design samples stay below it).
 CONFIRMATION_START = 10_000_000
@@ -85,11 +85,8 @@ def design_table(definition: CampaignDefinition, store: ResultsStore, count: int
     ``source`` column: ``store``, ``given`` or ``pending``); a sample pending in the store is
     taken from ``given`` (a DataFrame of the same columns) when it holds the sample's index
     with the same inputs."""
-    samples = plan_samples(definition, 0, count)
-    table = campaign_table(definition, store, samples)
-    table["source"] = np.where(table["status"] == "pending", "pending", "store")
-    if given is not None:
-        take_given(definition, table, given)
+    table, _ = report_table(definition, store, () if given is None else (given,),
+                            plan_samples(definition, 0, count), strict=True)
     return table
 
 

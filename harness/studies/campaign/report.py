@@ -48,14 +48,10 @@ def _interval(value, digits: int = 4) -> str:
     return f"{_fmt(value.value, digits)} [{_fmt(value.low, 3)}, {_fmt(value.high, 3)}]"
 
 
-def summarise(definition: CampaignDefinition, store: ResultsStore,
-              companions: tuple[CampaignDefinition, ...] = (), given=(),
-              table=None) -> dict:
-    """Everything the section shows, as plain data (also written as JSON); the runs from the
-    store, and the samples it lacks from the campaign CSVs ``given`` (DataFrames) that hold
-    them (:func:`report_table`), unless ``table`` is that table already."""
-    if table is None:
-        table, _ = report_table(definition, store, given)
+def summarise(definition: CampaignDefinition, store: ResultsStore, table,
+              companions: tuple[CampaignDefinition, ...] = ()) -> dict:
+    """Everything the section shows, as plain data (also written as JSON), from the
+    campaign's ``table`` (:func:`report_table`'s) and its log in ``store``."""
     ok = table[table["status"] == "ok"]
     statuses = table["status"].value_counts().to_dict()
     outputs = []
@@ -180,7 +176,7 @@ def write_campaign_report(definition: CampaignDefinition, store: ResultsStore,
     out = Path(out_dir)
     figures_dir = out / "figures"
     figures_dir.mkdir(parents=True, exist_ok=True)
-    summary = summarise(definition, store, companions, table=table)
+    summary = summarise(definition, store, table, companions)
     ok = table[table["status"] == "ok"]
     pngs: dict[str, bytes] = {}
     for spec, entry in zip(definition.outputs, summary["outputs"], strict=True):

@@ -195,12 +195,14 @@ def take_given(definition: CampaignDefinition, table, given, strict: bool = True
     return len(pending)
 
 
-def report_table(definition: CampaignDefinition, store: ResultsStore, given=()):
-    """:func:`campaign_table` with a ``source`` column (``store``, ``given`` or ``pending``),
-    its pending samples taken from each of the campaign CSVs ``given`` (DataFrames) that holds
-    them with this design's inputs (:func:`take_given`; another campaign's CSV is passed
-    over). Returns the table and how many rows each CSV filled."""
-    table = campaign_table(definition, store)
+def report_table(definition: CampaignDefinition, store: ResultsStore, given=(),
+                 samples=None, strict: bool = False):
+    """:func:`campaign_table` (of ``samples``, default every planned one) with a ``source``
+    column (``store``, ``given`` or ``pending``), its pending samples taken from each of the
+    campaign CSVs ``given`` (DataFrames) that holds them with this design's inputs
+    (:func:`take_given`, with ``strict``: False passes another campaign's CSV over). Returns
+    the table and how many rows each CSV filled."""
+    table = campaign_table(definition, store, samples)
     table["source"] = np.where(table["status"] == "pending", "pending", "store")
-    filled = [take_given(definition, table, frame, strict=False) for frame in given]
+    filled = [take_given(definition, table, frame, strict=strict) for frame in given]
     return table, filled

@@ -25,9 +25,10 @@ equal-count classes of the input's rank, over the output's variance.
 That estimator is taken here on all the runs, with SALib's number of classes and SALib's
 half-width (1.96 standard deviations of the estimator over bootstrap resamples of the runs).
 ``SALib.analyze.delta.analyze`` returns instead its value on one bootstrap resample of the runs:
-a point estimate with about 1.4 times the scatter and a floor above zero for an input that does
-nothing (on 200 designs of 1,024 runs of a linear response, 0.012 for an index of 0.003 against
-0.007 on all the runs: ``python -m tools.first_order_checks --linear-test``).
+a point estimate with 1.35 to 1.7 times the scatter on random runs, and a floor above the
+index of an input that does little (on 200 designs of 1,024 runs of a linear response, 0.013
+for an index of 0.003, against 0.008 on all the runs: ``python -m tools.first_order_checks
+--linear-test``).
 """
 
 from __future__ import annotations
