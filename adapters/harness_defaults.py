@@ -198,10 +198,6 @@ class HarnessDefaults:
         """The suite entries of ``engine``'s :attr:`regress_runs`."""
         return [run.entry(engine, self.regress_preset) for run in self.regress_runs]
 
-    def c60_ladder(self, plan: str, scene: str) -> Mapping[str, tuple[float, ...]]:
-        """Preset -> steps [ms] of ``scene`` in ``plan`` (empty when none is declared)."""
-        return self.c60_ladders.get(plan, {}).get(scene, {})
-
 
 #: What an engine that declares nothing gets.
 UNDECLARED = HarnessDefaults()

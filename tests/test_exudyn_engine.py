@@ -192,7 +192,7 @@ def test_runs_are_deterministic(name):
         np.testing.assert_array_equal(getattr(first, array), getattr(second, array))
 
 
-# ---------------------------------------------------------------------------- traps (ENGINES.md)
+# ------------------------------------------------------- traps (docs/engines/exudyn.md: Traps)
 def _first_apex_error(engine, options: dict | None = None) -> float:
     """First-apex relative error of bouncing-ball-e0.5 at dt 1e-3 (the shared evaluator)."""
     cell = run_cell(engine, get_scene("bouncing-ball-e0.5"), 1e-3, options=options)

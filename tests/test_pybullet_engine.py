@@ -206,7 +206,7 @@ def test_internal_units_are_recorded():
     assert create("default").run(scene, settings).internal_units.startswith("m-")
 
 
-# ---------------------------------------------------------------------------- traps (ENGINES.md)
+# ------------------------------------------ traps (docs/engines/pybullet.md: Traps guarded against)
 def test_defaults_swallow_the_bounce_and_tuned_restores_it():
     """Restitution trap: with PyBullet's defaults (restitution velocity threshold 0.2 m/s,
     penetration recovery by contactERP, body damping) bouncing-ball-e0.5 keeps almost no

@@ -42,12 +42,6 @@ PAPER_RUNS = 30_850
 CPK_HALF_WIDTH = 0.1
 
 
-def _interval(value, digits: int = 4) -> str:
-    if value is None:
-        return "limits not published"
-    return f"{_fmt(value.value, digits)} [{_fmt(value.low, 3)}, {_fmt(value.high, 3)}]"
-
-
 def summarise(definition: CampaignDefinition, store: ResultsStore, table,
               companions: tuple[CampaignDefinition, ...] = ()) -> dict:
     """Everything the section shows, as plain data (also written as JSON), from the
