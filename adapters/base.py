@@ -155,9 +155,15 @@ class Engine(ABC):
     # ------------------------------------------------------------------ capabilities
     def capabilities(self, scene: Scene, options: Mapping | None = None
                      ) -> dict[str, Capability]:
-        """Support of each feature of ``scene.features`` with the preset and ``options``."""
+        """Support of each feature of ``scene.features`` with the preset and ``options``
+        (checked first: OptionError naming the option and value)."""
         options = dict(options or {})
         self.check_options(options)
+        return self.checked_capabilities(scene, options)
+
+    def checked_capabilities(self, scene: Scene, options: Mapping) -> dict[str, Capability]:
+        """:meth:`capabilities` with ``options`` already checked (:meth:`check_options`: by
+        the run's spec, :mod:`clearbench.harness.run.spec`)."""
         context = self.feature_context(scene, options)
         problems = self.feature_problems(context)
         out = {}
@@ -214,8 +220,13 @@ class Engine(ABC):
         ]
 
     # ------------------------------------------------------------------ running
-    def run(self, scene: Scene, settings: RunSettings | None = None) -> Trajectory:
+    def run(self, scene: Scene, settings: RunSettings | None = None,
+            capabilities: Mapping[str, Capability] | None = None) -> Trajectory:
         """Run ``scene``; an unsupported scene gives an UNSUPPORTED trajectory, not an error.
+
+        ``capabilities``: the engine's :meth:`capabilities` for this scene and these options,
+        computed once by the caller that checked the options (the harness's run spec); None:
+        the options are checked and the capabilities computed here.
 
         Raises
         ------
@@ -224,8 +235,12 @@ class Engine(ABC):
             runs).
         """
         settings = settings or RunSettings()
-        self.check_options(settings.options)
-        reasons = self.unsupported_reasons(scene, settings.options)
+        if capabilities is None:
+            self.check_options(settings.options)
+            capabilities = self.checked_capabilities(scene, settings.options)
+        reasons = [f"{feature}: {capability.detail}"
+                   for feature, capability in sorted(capabilities.items())
+                   if capability.support is Support.UNSUPPORTED]
         if reasons:
             return Trajectory.empty(self.name, self.preset, scene, RunStatus.UNSUPPORTED,
                                     "; ".join(reasons))
@@ -266,18 +281,27 @@ class ModuleEngine(Engine):
         """The preset overridden by ``options`` (checked against :attr:`OPTIONS` by the
         settings object: OptionError naming the option and value)."""
         self.OPTIONS.check(options)
+        return self.resolve(options)
+
+    def resolve(self, options: Mapping | None) -> Any:
+        """The preset overridden by ``options`` as the engine's settings object (which checks
+        the values it holds: OptionError naming the option and value)."""
         return type(self).RESOLVE_SETTINGS(self.preset, options)
 
     def check_option_combination(self, options: Mapping) -> None:
-        self.settings(options)
+        self.resolve(options)
 
     def run_settings(self, scene: Scene, settings: RunSettings) -> Any:
-        """The settings of one run of ``scene``, resolved once: the preset overridden by
-        ``settings.options`` (checked against :attr:`OPTIONS`; OptionError naming the option
-        and value). An engine whose settings depend on the scene (tolerances relative to its
-        sizes) overrides it."""
+        """The settings of one run of ``scene``: :meth:`resolve_run_settings` with
+        ``settings.options`` checked first (OptionError naming the option and value)."""
         self.check_options(settings.options)
-        return self.settings(settings.options)
+        return self.resolve_run_settings(scene, settings)
+
+    def resolve_run_settings(self, scene: Scene, settings: RunSettings) -> Any:
+        """The settings of one run of ``scene``, its options already checked (by
+        :meth:`Engine.run`): the preset overridden by ``settings.options``. An engine whose
+        settings depend on the scene (tolerances relative to its sizes) overrides it."""
+        return self.resolve(settings.options)
 
     def capability_scene(self, scene: Scene, settings) -> Scene:
         """The scene the capabilities are stated for (default: as given; an engine that
@@ -285,7 +309,7 @@ class ModuleEngine(Engine):
         return scene
 
     def feature_context(self, scene: Scene, options: Mapping) -> Any:
-        settings = self.settings(options)
+        settings = self.resolve(options)
         scene = self.capability_scene(scene, settings)
         make = getattr(self.CAPABILITIES, "feature_context", None)
         return make(scene, settings) if make else FeatureQuery(scene, settings)
@@ -329,7 +353,7 @@ class SteppingEngine(ModuleEngine):
     TITLE: ClassVar[str] = ""
 
     def _run(self, scene: Scene, settings: RunSettings) -> Trajectory:
-        config = self.run_settings(scene, settings)
+        config = self.resolve_run_settings(scene, settings)
         start = time.perf_counter()
         internal = self.internal_scene(scene, config)
         to_internal = scene.units.factor_to(internal.units, TIME)

@@ -7,12 +7,22 @@ time profiles),
 ``clearbench.ref_solver`` (our nonsmooth Moreau--Jean solver), ``clearbench.adapters`` (one
 subpackage per engine) and ``clearbench.harness`` (runner, metrics, store, report, CLI).
 
-Importing the package points numba's on-disk cache (``NUMBA_CACHE_DIR``, unless the user set
-it) at a directory named after the state of the sources compiled kernels can read (every
-sub-package but the harness, whose modules hold no kernel another module calls) and numba's
-code-generation settings, when set (:func:`numba_cache_dir`). numba keys a cached kernel on its
-own file only: a kernel that inlines a function from another module would otherwise keep running
-the old code after that module is edited (it did once, and hid a fix).
+Which sources determine what (:func:`source_digest`):
+
+- a trajectory: the physics sources, :data:`PHYSICS_SUBPACKAGES` (kernels, scenarios,
+  ref_solver, adapters), with the scene, the engine, its settings and its package's version
+  (the run key, :attr:`clearbench.harness.run.spec.RunSpec.key`);
+- a run's measurement (figures, expectations, status after the harness's checks): the
+  trajectory and the measuring sources, :data:`MEASURING_SOURCES` (the measurement key);
+- numba's compiled kernels: the physics sources too. Importing the package points numba's
+  on-disk cache (``NUMBA_CACHE_DIR``, unless the user set it) at a directory named after
+  their state and numba's code-generation settings, when set (:func:`numba_cache_dir`).
+  numba keys a cached kernel on its own file only: a kernel that inlines a function from
+  another module would otherwise keep running the old code after that module is edited (it
+  did once, and hid a fix). The harness holds no kernel.
+
+An edit of the harness's report, CLI or studies code therefore reruns no engine and
+re-measures nothing; an edit of the measuring code re-measures the stored trajectories.
 """
 
 import functools
@@ -25,21 +35,32 @@ from pathlib import Path
 
 __version__ = "0.1.0"
 
-_SUBPACKAGES = ("clearbench.kernels", "clearbench.scenarios", "clearbench.ref_solver",
-                "clearbench.adapters", "clearbench.harness")
+#: The sub-packages whose sources determine a trajectory (with the scene, the engine, its
+#: settings and version): the part of every run key that is code, and what numba's cache
+#: directory is named after (they hold every kernel and what kernels inline). The harness is
+#: not among them: its run phase only hands the spec to the engine (``harness/run/worker.py``).
+PHYSICS_SUBPACKAGES = ("clearbench.kernels", "clearbench.scenarios", "clearbench.ref_solver",
+                       "clearbench.adapters")
 
-#: The sub-packages whose sources numba's cache directory is named after: those holding kernels
-#: or the constants and helpers kernels inline. An edit of the harness keeps the compiled
-#: kernels (a cold compile of every kernel costs minutes).
-_KERNEL_SUBPACKAGES = _SUBPACKAGES[:-1]
+#: The sources that determine a run's measurement from its trajectory, beyond the physics
+#: sources (the scene's geometry and expectations, the gap kernels): the measuring package
+#: and the worker module whose measuring phase decides the run's status.
+MEASURING_SOURCES = ("clearbench.harness.measure", "clearbench.harness.run.worker")
 
 
-def _source_files(subpackages: tuple[str, ...]):
-    """(subpackage name, path relative to the subpackage, path) of every module of
-    ``subpackages`` and of their own subpackages, in a fixed order."""
-    for name in subpackages:
+def _source_files(sources: tuple[str, ...]):
+    """(name, path relative to its package, path) of every module of ``sources`` (packages
+    with their own sub-packages, or single modules), in a fixed order."""
+    for name in sources:
         spec = importlib.util.find_spec(name)
-        for location in (spec.submodule_search_locations or []) if spec else []:
+        if spec is None:
+            continue
+        if spec.submodule_search_locations is None:  # a module
+            if spec.origin:
+                path = Path(spec.origin)
+                yield name, path.name, path
+            continue
+        for location in spec.submodule_search_locations:
             root = Path(location)
             for path in sorted(root.rglob("*.py")):
                 yield name, path.relative_to(root).as_posix(), path
@@ -48,28 +69,27 @@ def _source_files(subpackages: tuple[str, ...]):
 @functools.cache
 def _sources_fingerprint() -> str:
     """Digest of the path, size and modification time of every source file of
-    :data:`_KERNEL_SUBPACKAGES` [hex, 16 chars], computed once per process (every cache
+    :data:`PHYSICS_SUBPACKAGES` [hex, 16 chars], computed once per process (every cache
     directory a process names is of one state)."""
     digest = hashlib.sha1(__version__.encode())
-    for _, _, path in _source_files(_KERNEL_SUBPACKAGES):
+    for _, _, path in _source_files(PHYSICS_SUBPACKAGES):
         stat = path.stat()
         digest.update(f"{path}:{stat.st_size}:{stat.st_mtime_ns}\n".encode())
     return digest.hexdigest()[:16]
 
 
-def source_digest(subpackages: tuple[str, ...] = _SUBPACKAGES) -> str:
-    """sha256 of the sources of ``subpackages`` (relative path and content of every module)
-    [hex, 16 chars], computed once per process and selection. Part of every stored run's key
-    (all subpackages), so that a result computed by other code is never served as this code's
-    (``clearbench run`` reran nothing after an adapter fix before); the same on every clone of
-    the same revision. The C-60 validation cache keys its runs on the physics subpackages."""
-    if subpackages not in _SOURCE_DIGESTS:
+def source_digest(sources: tuple[str, ...] = PHYSICS_SUBPACKAGES) -> str:
+    """sha256 of the sources of ``sources`` (packages or modules: relative path and content of
+    every module) [hex, 16 chars], computed once per process and selection; the same on every
+    clone of the same revision. The physics sources' digest is part of every run key, the
+    measuring sources' of every measurement key (see the module docstring)."""
+    if sources not in _SOURCE_DIGESTS:
         digest = hashlib.sha256(__version__.encode())
-        for name, relative, path in _source_files(subpackages):
+        for name, relative, path in _source_files(sources):
             digest.update(f"{name}/{relative}\n".encode())
             digest.update(path.read_bytes())
-        _SOURCE_DIGESTS[subpackages] = digest.hexdigest()[:16]
-    return _SOURCE_DIGESTS[subpackages]
+        _SOURCE_DIGESTS[sources] = digest.hexdigest()[:16]
+    return _SOURCE_DIGESTS[sources]
 
 
 _SOURCE_DIGESTS: dict[tuple[str, ...], str] = {}
@@ -111,7 +131,7 @@ def write_json(path: Path, data, **dumps_options) -> None:
 
 def checkout_cache_dir() -> Path:
     """The cache directory of this checkout and the state of its physics sources (those of
-    :data:`_KERNEL_SUBPACKAGES`): numba's kernels and what is derived from those sources
+    :data:`PHYSICS_SUBPACKAGES`): numba's kernels and what is derived from those sources
     alone (the features of the registered scenes) live there; older states' are pruned."""
     return _checkout_cache_root() / _sources_fingerprint()
 

@@ -57,7 +57,7 @@ def test_a_changed_scene_preset_or_code_is_another_run(tmp_path, monkeypatch):
     other_preset = StudyRuns(ResultsStore(tmp_path), run_missing=False,
                              engine="reference[nsgs]")
     assert other_preset.spec(request).key != key
-    monkeypatch.setitem(clearbench._SOURCE_DIGESTS, clearbench._SUBPACKAGES, "0" * 16)
+    monkeypatch.setitem(clearbench._SOURCE_DIGESTS, clearbench.PHYSICS_SUBPACKAGES, "0" * 16)
     assert StudyRuns(ResultsStore(tmp_path), run_missing=False).spec(request).key != key
 
 

@@ -374,11 +374,12 @@ def test_a_run_keyed_by_other_sources_stops_the_campaign_by_name(tmp_path):
     # and stops with the sample named, rather than wait for a key that never comes.
     from dataclasses import asdict
 
+    from clearbench.harness.run.messages import MeasuredMessage, RanMessage
     from clearbench.harness.run.store import RunRecord, machine_info, revision_info
 
     sample = plan_samples(parse_campaign(pendulum_campaign()))[0]
-    row = asdict(RunRecord.from_worker(sample.spec, {"status": "ok", "message": ""}, {},
-                                       revision_info(), machine_info()))
+    row = asdict(RunRecord.from_messages(sample.spec, RanMessage(status="ok"),
+                                         MeasuredMessage(), revision_info(), machine_info()))
     store = ResultsStore(tmp_path / "store")
     assert execution._record(store, sample, {"row": row, "trajectory": None}).key == \
         sample.spec.key

@@ -112,15 +112,50 @@ def test_engine_labels():
         parse_engine_label("a b")
 
 
-def test_run_key_changes_with_the_code(monkeypatch):
-    # A stored result of other code is never served as this code's (an adapter fix must not
-    # need --rerun); the digest is of the sources' contents, the same on every clone.
+def test_run_key_changes_with_the_physics_code_only(monkeypatch):
+    # A trajectory of other physics code is never served as this code's (an adapter fix must
+    # not need --rerun); the digest is of the sources' contents, the same on every clone. The
+    # measuring code keys the measurement alone: its edit re-measures, reruns nothing.
     import clearbench
 
-    base = fake_spec().key
+    key, measure_key = fake_spec().key, fake_spec().measure_key
     assert clearbench.source_digest() == clearbench.source_digest()
-    monkeypatch.setitem(clearbench._SOURCE_DIGESTS, clearbench._SUBPACKAGES, "0" * 16)
-    assert fake_spec().key != base
+    monkeypatch.setitem(clearbench._SOURCE_DIGESTS, clearbench.MEASURING_SOURCES, "0" * 16)
+    assert fake_spec().key == key and fake_spec().measure_key != measure_key
+    monkeypatch.setitem(clearbench._SOURCE_DIGESTS, clearbench.PHYSICS_SUBPACKAGES, "0" * 16)
+    assert fake_spec().key != key
+
+
+def test_the_harness_is_not_a_physics_source():
+    import clearbench
+
+    assert not any(name.startswith("clearbench.harness")
+                   for name in clearbench.PHYSICS_SUBPACKAGES)
+    key_fields = fake_spec().key_fields
+    assert key_fields["engine_version"] == "fake engine for tests 1.0"
+    assert key_fields["plug_in"]  # an engine outside the package: its own source digest
+
+
+def test_a_changed_measuring_code_measures_the_stored_trajectory_again(tmp_path, monkeypatch):
+    import clearbench
+
+    store = ResultsStore(tmp_path / "store")
+    spec = fake_spec("nan")
+    Runner(store, jobs=1).run_all([spec])
+    first = store.get(spec.key)
+    assert first["measure_key"] == spec.measure_key
+    first_measure_key = spec.measure_key
+    assert first["status"] == "diverged" and first["engine_status"] == "ok"
+    assert first["verdict"] == "diverged"
+    monkeypatch.setitem(clearbench._SOURCE_DIGESTS, clearbench.MEASURING_SOURCES, "0" * 16)
+    again = Runner(store, jobs=1).run_all([spec])
+    assert again.ran == [] and again.skipped == [spec.key] and again.remeasured == [spec.key]
+    second = store.get(spec.key)
+    assert second["measure_key"] == spec.measure_key != first_measure_key
+    for column in ("status", "message", "engine_status", "metrics", "verdict", "trajectory",
+                   "stepping_seconds", "recorded_utc"):
+        assert second[column] == first[column], column
+    assert Runner(store, jobs=1).run_all([spec]).remeasured == []
 
 
 def test_run_key_identifies_the_physics_and_settings_only():
@@ -249,7 +284,7 @@ def test_kill_9_of_a_sweep_then_rerun_gives_every_run_exactly_once(tmp_path):
     again = subprocess.run(command, cwd=ROOT, env=subprocess_env(), capture_output=True,
                            text=True, timeout=120)
     assert again.returncode == 0, again.stderr
-    counts = re.search(r"(\d+) runs done, (\d+) already", again.stdout)
+    counts = re.search(r"(\d+) runs done, (\d+) reused", again.stdout)
     done, reused = int(counts.group(1)), int(counts.group(2))
     assert reused >= recorded_before and done + reused == 8
     with sqlite3.connect(database) as connection:

@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 
 from clearbench.adapters.trajectory import RunStatus, Trajectory
+from clearbench.harness.run.messages import MeasuredMessage, RanMessage
 from clearbench.harness.run.spec import make_run_spec
 from clearbench.harness.run.store import (
     COLUMNS,
@@ -23,14 +24,14 @@ from .harness_helpers import FAKE
 
 
 def _record(spec, status="ok", figures=None):
-    ran = {"status": status, "message": "", "worker_seconds": 0.5, "build_seconds": 0.1,
-           "stepping_seconds": 0.2, "steps": 100, "samples": 101, "engine_version": "v1",
-           "capabilities": {"gravity": ["native", ""]}, "trajectory_saved": False}
-    measured = {"figures": figures or {"penetration_max": 1e-6, "error": 0.01},
-                "expectations": [{"name": "e", "kind": "no_penetration", "passed": True}],
-                "verdict": status, "verdict_reason": "", "error_source": "analytic (e)",
-                "metrics_error": ""}
-    return RunRecord.from_worker(spec, ran, measured, revision_info(), machine_info())
+    ran = RanMessage(status=status, message="", worker_seconds=0.5, build_seconds=0.1,
+                     stepping_seconds=0.2, steps=100, samples=101, engine_version="v1",
+                     capabilities={"gravity": ["native", ""]}, trajectory_saved=False)
+    measured = MeasuredMessage(
+        status=status, figures=figures or {"penetration_max": 1e-6, "error": 0.01},
+        expectations=[{"name": "e", "kind": "no_penetration", "passed": True}],
+        error_source="analytic (e)")
+    return RunRecord.from_messages(spec, ran, measured, revision_info(), machine_info())
 
 
 def test_record_is_keyed_and_never_duplicated(tmp_path):
@@ -127,3 +128,21 @@ def test_a_runner_removes_the_temporary_files_a_killed_sweep_left(tmp_path):
         os.utime(path, (two_hours_ago, two_hours_ago))
     Runner(store, jobs=1)
     assert sorted(p.name for p in folder.iterdir()) == sorted([fresh.name, kept.name])
+
+
+def test_a_version_1_store_is_migrated_and_its_runs_kept(tmp_path):
+    # A store of the first schema (no verdict nor measure_key columns): opened, it gains them;
+    # its rows stay readable (their keys were computed by other rules and match no new run).
+    spec = make_run_spec("bouncing-ball-e0.5", "fake", extra_engine_modules=FAKE)
+    store = ResultsStore(tmp_path / "store")
+    store.record(_record(spec), scene=spec.scene)
+    with sqlite3.connect(store.path) as connection:
+        for column in ("verdict", "measure_key"):
+            connection.execute(f"ALTER TABLE runs DROP COLUMN {column}")
+        connection.execute("UPDATE meta SET value = '1' WHERE name = 'schema_version'")
+    migrated = ResultsStore(tmp_path / "store")
+    row = migrated.get(spec.key)
+    assert row["status"] == "ok" and row["verdict"] == "" and row["measure_key"] == ""
+    assert migrated.reusable() == {spec.key: ""}
+    with sqlite3.connect(store.path) as connection:
+        assert connection.execute("SELECT value FROM meta").fetchone()[0] == "2"

@@ -21,6 +21,7 @@ import time
 from collections import defaultdict
 
 import clearbench  # noqa: F401  (sets NUMBA_CACHE_DIR before numba reads its configuration)
+from clearbench.harness.run.messages import WorkerRequest
 from clearbench.harness.run.numba_cache import reference_specs
 from clearbench.harness.run.worker import measure_phase, run_phase
 from clearbench.scenarios.library import scene_names
@@ -76,14 +77,13 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as scratch:
         for index, spec in enumerate(reference_specs(args.scenes or scene_names())):
             tick = time.perf_counter()
-            request = spec.to_message() | {"trajectory_path": f"{scratch}/{index}.npz",
-                                           "reference_path": None, "reference_label": ""}
+            request = WorkerRequest.of(spec, f"{scratch}/{index}.npz")
             ran, scene, trajectory = run_phase(request)
             measure_phase(request, scene, trajectory)
             runs.append({"scene": spec.scene.name, "step_loop": spec.options_dict["step_loop"],
-                         "seconds": time.perf_counter() - tick, "status": ran["status"]})
+                         "seconds": time.perf_counter() - tick, "status": ran.status})
             print(f"{spec.scene.name:<26} step_loop={runs[-1]['step_loop']:<7} "
-                  f"{runs[-1]['seconds']:7.1f} s  {ran['status']}", flush=True)
+                  f"{runs[-1]['seconds']:7.1f} s  {ran.status}", flush=True)
     total = time.perf_counter() - start
     names = sorted(clock.own, key=clock.own.get, reverse=True)
     print(f"\nall runs {total:.0f} s; compiling {sum(clock.top.values()):.0f} s, "

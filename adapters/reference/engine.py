@@ -65,15 +65,14 @@ class ReferenceEngine(ModuleEngine):
                               "needs projection = true (it relies on the activation loop of "
                               "the combined projection)")
 
-    def run_settings(self, scene: Scene, settings: RunSettings) -> StepperSettings:
-        """Preset + options (checked), with tolerances relative to the scene's smallest
-        feature (:func:`.settings.stepper_settings`)."""
-        self.check_options(settings.options)
+    def resolve_run_settings(self, scene: Scene, settings: RunSettings) -> StepperSettings:
+        """Preset + options, with tolerances relative to the scene's smallest feature
+        (:func:`.settings.stepper_settings`)."""
         return stepper_settings(self.preset, scene, settings)
 
     def _run(self, scene: Scene, settings: RunSettings) -> Trajectory:
         start = time.perf_counter()
-        config = self.run_settings(scene, settings)
+        config = self.resolve_run_settings(scene, settings)
         model = build(scene, config, python_step=False)
         stepper, state = model.stepper, model.state
         h = config.time_step

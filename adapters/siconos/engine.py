@@ -81,15 +81,13 @@ class SiconosEngine(ModuleEngine):
     CAPABILITIES = capabilities
     RESOLVE_SETTINGS = staticmethod(resolve_settings)
 
-    def run_settings(self, scene: Scene, settings: RunSettings) -> dict:
-        """The settings of a run of ``scene`` (options checked against :data:`OPTIONS`):
-        :func:`~.settings.resolve_options`."""
-        self.check_options(settings.options)
+    def resolve_run_settings(self, scene: Scene, settings: RunSettings) -> dict:
+        """The settings of a run of ``scene``: :func:`~.settings.resolve_options`."""
         return resolve_options(self.preset, scene, settings.options)
 
     # ------------------------------------------------------------------ run
     def _run(self, scene: Scene, settings: RunSettings) -> Trajectory:
-        options = self.run_settings(scene, settings)
+        options = self.resolve_run_settings(scene, settings)
         h = settings.time_step or scene.time_step
         horizon = settings.horizon or scene.horizon
         worker_settings = {key: options[key] for key in options if key != "timeout"}

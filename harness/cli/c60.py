@@ -232,7 +232,7 @@ def run_c60_plan(plan_name: str, labels, modules, args, store) -> set[str]:
     specs = c60_plan_specs(plan_name, labels, modules)
     runner = make_runner(args, store, len(specs))
     outcome = runner.run_all(specs)
-    print(f"C-60: {len(outcome.ran)} runs done, {len(outcome.skipped)} reused from the store")
+    print(f"C-60: {outcome.summary()}")
     print_c60(store, {s.key for s in specs})
     return {s.key for s in specs}
 

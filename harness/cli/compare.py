@@ -133,11 +133,8 @@ def run_compare(args: argparse.Namespace) -> int:
                            extra_modules=modules)
     outcome = execute_plan(plan, runner, before=[*warm_up, *c60])
     if stiff:
-        more = runner.run_all(stiff)
-        outcome.ran += more.ran
-        outcome.skipped += more.skipped
-    print(f"{len(outcome.ran)} runs done, {len(outcome.skipped)} reused from the store, "
-          f"{time.monotonic() - start:.0f} s")
+        outcome.extend(runner.run_all(stiff))
+    print(f"{outcome.summary()}, {time.monotonic() - start:.0f} s")
     print_work_precision(store, [s.scene.name for s in plan.all_specs],
                          {s.key for s in plan.all_specs})
     if c60:

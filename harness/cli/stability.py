@@ -52,7 +52,7 @@ def run_stability(args: argparse.Namespace) -> int:
     store = open_store(args)
     runner = make_runner(args, store, len(specs))
     outcome = runner.run_all(specs, rerun=args.rerun)
-    print(f"{len(outcome.ran)} runs done, {len(outcome.skipped)} already in {store.directory}")
+    print(f"{outcome.summary()} ({store.directory})")
     rows = stability_rows(store.dataframe(), specs)
     scenes = {spec.scene.name: spec.scene for spec in specs}
     case = None

@@ -98,7 +98,7 @@ def run_sweep(args: argparse.Namespace) -> int:
     store = open_store(args)
     runner = make_runner(args, store, len(plan.all_specs))
     outcome = execute_plan(plan, runner, rerun=args.rerun)
-    print(f"{len(outcome.ran)} runs done, {len(outcome.skipped)} already in {store.directory}")
+    print(f"{outcome.summary()} ({store.directory})")
     print_work_precision(store, [spec.scene.name for spec in plan.all_specs],
                          {spec.key for spec in plan.all_specs})
     return 0

@@ -1,4 +1,4 @@
-"""Run many :class:`~.run_spec.RunSpec` in isolated worker processes, in parallel, into a store.
+"""Run many :class:`~.spec.RunSpec` in isolated worker processes, in parallel, into a store.
 
 Each run executes in a worker process started with the ``spawn`` context (by default a fresh
 one per run: ``runs_per_worker=1``). The parent waits on the workers' pipes and process
@@ -12,11 +12,15 @@ and the parent carries on with the rest of the sweep. A run is written to the re
 once complete (outcome and metrics), in one transaction, under its deterministic key; runs whose
 key is already in the store are skipped (served from it), except crashed ones, which are run
 again (:data:`~.store.RERUN_STATUSES`), so a sweep interrupted even by ``kill -9`` resumes
-without losing or duplicating runs.
+without losing or duplicating runs. A stored run whose measurement key differs (the measuring
+code changed, :attr:`~.spec.RunSpec.measure_key`) is served too, after a worker measured its
+stored trajectory again. The messages between the parent, its workers and the store are the
+dataclasses of :mod:`.messages`.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import multiprocessing
 import multiprocessing.connection
@@ -31,6 +35,7 @@ from pathlib import Path
 
 import clearbench
 from clearbench.adapters.trajectory import RunStatus
+from clearbench.harness.run.messages import MeasuredMessage, RanMessage, WorkerRequest
 from clearbench.harness.run.spec import RunSpec
 from clearbench.harness.run.store import ResultsStore, RunRecord, machine_info, revision_info
 from clearbench.harness.run.worker import worker_main
@@ -63,11 +68,14 @@ class RunJob:
 
     A ``warm_up`` job fills numba's cache of its engine for the jobs after it: it is started
     before any other job of its engine, one at a time, while the other workers run other
-    engines' jobs; its result is not stored nor counted (:meth:`Runner.run_all`)."""
+    engines' jobs; its result is not stored nor counted (:meth:`Runner.run_all`). A
+    ``remeasure`` job (made by :meth:`Runner.run_all`) measures the stored trajectory of its
+    run again and runs nothing."""
 
     spec: RunSpec
     reference_key: str | None = None
     warm_up: bool = False
+    remeasure: bool = False
 
 
 @dataclass
@@ -79,17 +87,33 @@ class _Slot:
     phase: str = ""
     deadline: float = 0.0
     started: float = 0.0
-    ran: dict | None = None
+    ran: RanMessage | None = None
     trajectory_tmp: Path | None = None
 
 
 @dataclass
 class SweepOutcome:
-    """What :func:`run_all` did: keys run now, keys found already stored, records written."""
+    """What :func:`run_all` did: keys run now, keys served from the store (``skipped``; those
+    of them whose stored trajectory was measured again also in ``remeasured``), records
+    written (runs made now)."""
 
     ran: list[str] = field(default_factory=list)
     skipped: list[str] = field(default_factory=list)
     records: list[RunRecord] = field(default_factory=list)
+    remeasured: list[str] = field(default_factory=list)
+
+    def extend(self, other: SweepOutcome) -> None:
+        """Add what ``other`` did."""
+        self.ran += other.ran
+        self.skipped += other.skipped
+        self.records += other.records
+        self.remeasured += other.remeasured
+
+    def summary(self) -> str:
+        """``"N runs done, M reused from the store (K measured again)"``."""
+        again = f" ({len(self.remeasured)} measured again)" if self.remeasured else ""
+        return (f"{len(self.ran)} runs done, {len(self.skipped)} reused from the store"
+                + again)
 
 
 def _signal_name(exitcode: int | None) -> str:
@@ -198,16 +222,17 @@ class Runner:
         """Run every job whose key is not yet in the store, or stored as crashed
         (:data:`~.store.RERUN_STATUSES`; every job with ``rerun``).
 
-        Jobs with the same key are run once. Returns what was run and what was skipped.
-        Warm-up jobs (:class:`RunJob`) run first for their engine, always, and are not stored:
-        from an empty cache one worker compiles an engine's kernels once, instead of every
-        worker compiling the same kernels side by side, and the other workers go on with
-        other engines' runs meanwhile.
+        Jobs with the same key are run once. Returns what was run and what was skipped (served
+        from the store; a stored run whose measurement key differs is measured again from its
+        trajectory first). Warm-up jobs (:class:`RunJob`) run first for their engine, always,
+        and are not stored: from an empty cache one worker compiles an engine's kernels once,
+        instead of every worker compiling the same kernels side by side, and the other
+        workers go on with other engines' runs meanwhile.
         """
         outcome = SweepOutcome()
         queue: deque[RunJob] = deque()
         seen: set[str] = set()
-        stored = self.store.reusable_keys()
+        stored = self.store.reusable()
         for job in jobs:
             job = job if isinstance(job, RunJob) else RunJob(job)
             key = job.spec.key
@@ -218,6 +243,8 @@ class Runner:
                 queue.append(job)
             elif key in stored and not rerun:
                 outcome.skipped.append(key)
+                if stored[key] != job.spec.measure_key:
+                    queue.append(dataclasses.replace(job, remeasure=True))
             else:
                 queue.append(job)
         if not queue:
@@ -240,22 +267,28 @@ class Runner:
 
     def _dispatch(self, slot: _Slot, job: RunJob) -> None:
         spec = job.spec
-        request = spec.to_message()
-        tmp = self.store.trajectory_dir / f".{spec.key}.{os.getpid()}.tmp.npz"
-        request["trajectory_path"] = str(tmp)
-        reference = None
+        if job.remeasure:
+            tmp = None
+            trajectory = self.store.trajectory_path(spec.key)
+        else:
+            tmp = self.store.trajectory_dir / f".{spec.key}.{os.getpid()}.tmp.npz"
+            trajectory = tmp
+        reference = ""
         if job.reference_key:
             path = self.store.trajectory_path(job.reference_key)
-            reference = str(path) if path.exists() else None
-        request["reference_path"] = reference
-        request["reference_label"] = f"reference run {job.reference_key}" if reference else ""
-        slot.job, slot.phase, slot.ran, slot.trajectory_tmp = job, "run", None, tmp
+            reference = str(path) if path.exists() else ""
+        request = WorkerRequest.of(
+            spec, str(trajectory), reference_path=reference,
+            reference_label=f"reference run {job.reference_key}" if reference else "",
+            measure_only=job.remeasure)
+        slot.job, slot.ran, slot.trajectory_tmp = job, None, tmp
+        slot.phase = "measure" if job.remeasure else "run"
         slot.started = time.monotonic()
-        slot.deadline = slot.started + spec.timeout
+        slot.deadline = slot.started + (self.measure_timeout if job.remeasure else spec.timeout)
         slot.conn.send(request)
 
     def _loop(self, queue: deque, outcome: SweepOutcome, bar) -> None:
-        total = sum(not job.warm_up for job in queue)
+        total = sum(not (job.warm_up or job.remeasure) for job in queue)
         while queue or any(s.job is not None for s in self._slots):
             # fill idle slots
             while queue and (len(self._slots) < self.jobs
@@ -278,6 +311,8 @@ class Runner:
                 finished = self._service(slot)
                 if finished is not None and job.warm_up:
                     self._finish_warm_up(slot, finished)
+                elif finished is not None and job.remeasure:
+                    self._finish_remeasure(slot, finished, outcome)
                 elif finished is not None:
                     record = self._finish(slot, finished, outcome)
                     if self.on_finished is not None:
@@ -322,10 +357,21 @@ class Runner:
         tmp = finished.trajectory_tmp
         if tmp is not None and tmp.exists():
             tmp.unlink()
-        status = finished.ran.get("status")
-        if status != RunStatus.OK.value:
-            LOG.warning("warm-up %s: %s %s", finished.spec.label, status,
-                        finished.ran.get("message", ""))
+        if finished.ran.status != RunStatus.OK.value:
+            LOG.warning("warm-up %s: %s %s", finished.spec.label, finished.ran.status,
+                        finished.ran.message)
+
+    def _finish_remeasure(self, slot: _Slot, finished: _Finished,
+                          outcome: SweepOutcome) -> None:
+        """A stored run was measured again: its row takes the new measurement."""
+        self._release(slot, finished)
+        spec = finished.spec
+        row = self.store.get(spec.key)
+        if row is None:  # removed meanwhile: nothing to update
+            return
+        self.store.remeasure(RunRecord.from_row(row).measured(finished.measured,
+                                                             spec.measure_key))
+        outcome.remeasured.append(spec.key)
 
     def _service(self, slot: _Slot):
         """Advance ``slot``; return a _Finished when its run is complete."""
@@ -334,14 +380,14 @@ class Runner:
         try:
             while slot.conn.poll():
                 message = slot.conn.recv()
-                if message["phase"] == "ran":
+                if isinstance(message, RanMessage):
                     slot.ran = message
                     slot.phase = "measure"
                     slot.deadline = time.monotonic() + self.measure_timeout
-                elif message["phase"] == "measured":
+                elif isinstance(message, MeasuredMessage):
                     slot.runs_done += 1
-                    return _Finished(job.spec, slot.ran, message, slot.trajectory_tmp,
-                                     worker_ok=True)
+                    return _Finished(job.spec, slot.ran or RanMessage(), message,
+                                     slot.trajectory_tmp, worker_ok=True)
         except (EOFError, OSError):
             pass  # the worker died; handled below
         if not slot.process.is_alive() or slot.conn.closed:
@@ -361,15 +407,11 @@ class Runner:
             self._kill(slot)
         elapsed = time.monotonic() - slot.started
         if slot.phase == "run":
-            ran = {"status": status.value, "message": message, "worker_seconds": elapsed,
-                   "capabilities": {}, "engine_version": "", "trajectory_saved": False}
-            measured = {"figures": {}, "expectations": [], "verdict": None,
-                        "verdict_reason": "", "error_source": "", "metrics_error": ""}
-        else:  # the run finished; its measuring died
-            ran = slot.ran
-            measured = {"figures": {}, "expectations": [], "verdict": None,
-                        "verdict_reason": "", "error_source": "",
-                        "metrics_error": f"measuring {status.value}: {message}"}
+            ran = RanMessage(status=status.value, message=message, worker_seconds=elapsed)
+            measured = MeasuredMessage()
+        else:  # the run finished (or was stored); its measuring died
+            ran = slot.ran or RanMessage()
+            measured = MeasuredMessage(metrics_error=f"measuring {status.value}: {message}")
         finished = _Finished(slot.job.spec, ran, measured, slot.trajectory_tmp, worker_ok=False)
         self._slots.remove(slot)
         return finished
@@ -386,10 +428,10 @@ class Runner:
     def _finish(self, slot: _Slot, finished: _Finished, outcome: SweepOutcome) -> RunRecord:
         spec = finished.spec
         self._release(slot, finished)
-        record = RunRecord.from_worker(spec, finished.ran, finished.measured,
-                                       self._revision, self._machine)
+        record = RunRecord.from_messages(spec, finished.ran, finished.measured,
+                                         self._revision, self._machine)
         tmp = finished.trajectory_tmp
-        saved = bool(finished.ran.get("trajectory_saved")) and tmp is not None and tmp.exists()
+        saved = finished.ran.trajectory_saved and tmp is not None and tmp.exists()
         # Replacing: a rerun, or a run stored as crashed that was run again.
         self.store.record(record, trajectory_file=tmp if saved else None, replace=True,
                           scene=spec.scene)
@@ -432,8 +474,8 @@ def _environment_set(variables: Mapping[str, str]):
 @dataclass
 class _Finished:
     spec: RunSpec
-    ran: dict
-    measured: dict
+    ran: RanMessage
+    measured: MeasuredMessage
     trajectory_tmp: Path | None
     worker_ok: bool
 

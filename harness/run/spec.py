@@ -3,14 +3,24 @@
 A :class:`RunSpec` is built by :func:`make_run_spec`, which validates everything (scene name and
 parameters or scene file, engine, preset, time step, horizon, ...) and raises
 :class:`~.engine_choice.RunInputError` naming the field and value at fault before any engine
-runs. The run key is a sha256 of the scene's content hash, the engine, the preset and the
-resolved settings: the same run asked twice (by any command) has the same key, so the results
-store records it once and an interrupted sweep resumes where it stopped.
+runs. The run key is a sha256 of what determines the trajectory: the scene's content hash, the
+engine, its preset, version and settings, and the physics sources
+(:data:`clearbench.PHYSICS_SUBPACKAGES`): the same run asked twice (by any command) has the same
+key, so the results store records it once and an interrupted sweep resumes where it stopped,
+and an edit of the harness (measuring, report, CLI) reruns no engine. The measurement key
+(:attr:`RunSpec.measure_key`) adds the measuring sources: a stored run whose measurement key
+changed is measured again from its stored trajectory, and no engine runs.
+
+The options are checked once, here (by the engine's own declaration); the run's capabilities
+are computed once, from the spec (:attr:`RunSpec.capabilities`), and handed to the worker.
 """
 
 from __future__ import annotations
 
+import functools
 import hashlib
+import importlib
+import importlib.metadata
 import inspect
 import json
 import math
@@ -28,7 +38,7 @@ from clearbench.harness.run.engine_choice import (
 )
 from clearbench.scenarios.library import get_entry, scene_names
 from clearbench.scenarios.scene import Scene
-from clearbench.scenarios.serialization import load_scene_file, scene_to_dict
+from clearbench.scenarios.serialization import load_scene_file
 from clearbench.scenarios.validation import SceneError
 
 #: Wall-clock limit of one run when none is given [s].
@@ -194,12 +204,17 @@ class RunSpec:
 
     @property
     def key_fields(self) -> dict:
-        """What identifies the run (hashed into :attr:`key`): the scene, the engine and its
-        settings, and the package's code (:func:`clearbench.source_digest`)."""
+        """What determines the trajectory (hashed into :attr:`key`): the scene, the engine,
+        its version and settings, the physics sources (:func:`clearbench.source_digest`),
+        numpy's and numba's versions, and the source of an engine module outside the package
+        (a plug-in)."""
         return {
-            "code": clearbench.source_digest(),
+            "physics": clearbench.source_digest(clearbench.PHYSICS_SUBPACKAGES),
+            "libraries": _library_versions(),
+            "plug_in": _plug_in_digest(self.engine.module),
             "scene_hash": self.scene.content_hash,
             "engine": self.engine.name,
+            "engine_version": self.engine.detail,
             "preset": self.engine.preset,
             "time_step": float(self.time_step),
             "horizon": float(self.horizon),
@@ -210,26 +225,56 @@ class RunSpec:
     @property
     def key(self) -> str:
         """Deterministic run key: sha256 of the canonical JSON of :attr:`key_fields`, 24 hex."""
-        text = json.dumps(self.key_fields, sort_keys=True, separators=(",", ":"))
-        return hashlib.sha256(text.encode()).hexdigest()[:24]
+        return _digest(self.key_fields)
+
+    @property
+    def measure_key(self) -> str:
+        """What determines the run's measurement, 24 hex: its run key and the measuring
+        sources (:data:`clearbench.MEASURING_SOURCES`). (The run its error is measured
+        against is the batch's choice: a stored measurement is served whatever it was.)"""
+        return _digest({"run": self.key,
+                        "measuring": clearbench.source_digest(clearbench.MEASURING_SOURCES)})
 
     @property
     def label(self) -> str:
         return f"{self.scene.name} {self.engine.label} dt={self.time_step:g}"
 
-    def to_message(self) -> dict:
-        """The JSON-serialisable form a worker process receives."""
-        return {
-            "key": self.key,
-            "scene": scene_to_dict(self.scene),
-            "engine": self.engine.name,
-            "preset": self.engine.preset,
-            "module": self.engine.module,
-            "time_step": self.time_step,
-            "horizon": self.horizon,
-            "record_every": self.record_every,
-            "options": self.options_dict,
-        }
+    @functools.cached_property
+    def capabilities(self) -> dict[str, list[str]]:
+        """Feature -> [support, detail] of the engine for this scene and options (computed
+        once, when first asked: when the run is dispatched; the options were checked when the
+        spec was made)."""
+        engine = importlib.import_module(self.engine.module).create(self.engine.preset)
+        return {feature: [capability.support.value, capability.detail]
+                for feature, capability in sorted(
+                    engine.checked_capabilities(self.scene, self.options_dict).items())}
+
+
+def _digest(fields: Mapping) -> str:
+    """sha256 of the canonical JSON of ``fields`` [hex, 24 chars]."""
+    text = json.dumps(fields, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:24]
+
+
+@functools.cache
+def _library_versions() -> dict[str, str]:
+    """The versions of the numerical libraries every engine's adapter computes with."""
+    versions = {}
+    for name in ("numpy", "numba"):
+        try:
+            versions[name] = importlib.metadata.version(name)
+        except importlib.metadata.PackageNotFoundError:  # a source build without metadata
+            versions[name] = "unknown"
+    return versions
+
+
+@functools.cache
+def _plug_in_digest(module: str) -> str:
+    """The source digest of an engine module outside clearbench (its package's modules, or
+    the module); '' for an engine of the package (its sources are physics sources)."""
+    if module == "clearbench" or module.startswith("clearbench."):
+        return ""
+    return clearbench.source_digest((module,))
 
 
 def make_run_spec(scene: str | Path | Scene, engine: str, *,

@@ -2,8 +2,10 @@
 
 Layout of a store directory::
 
-    runs.sqlite            table ``runs`` (one row per run, keyed), table ``scenes`` (scene JSON
-                           by content hash), table ``meta`` (schema version)
+    runs.sqlite            table ``runs`` (one row per run, keyed by what determines its
+                           trajectory, with the key of what determines its measurement), table
+                           ``scenes`` (scene JSON by content hash), table ``meta`` (schema
+                           version)
     trajectories/KEY.npz   the trajectory of run KEY (clearbench.adapters.trajectory format)
 
 A run is recorded only when complete, in one transaction (the trajectory file is moved into
@@ -16,6 +18,7 @@ killed at any instant leaves either the whole run or nothing. ``pandas`` reads i
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import json
 import math
 import os
@@ -32,11 +35,15 @@ from pathlib import Path
 
 import clearbench
 from clearbench.adapters.trajectory import RunStatus, Trajectory
+from clearbench.harness.measure.verdicts import run_verdict
+from clearbench.harness.run.messages import MeasuredMessage, RanMessage
 from clearbench.harness.run.spec import RunSpec
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.serialization import scene_from_dict, scene_to_dict
 
-SCHEMA_VERSION = 1
+#: Version 2 added ``measure_key`` and ``verdict``; a version-1 store is migrated when opened
+#: (its runs are keyed by other rules: none is reused, each is run again when asked for).
+SCHEMA_VERSION = 2
 #: Stored outcomes that are run again when asked for, rather than served from the store. A
 #: crash is not always a property of the run: a worker killed from outside (out of memory, a
 #: signal), an engine's interpreter failing to start, an input no check caught; served, it
@@ -53,9 +60,13 @@ class RunRecord:
     """One row of the ``runs`` table (units: seconds for wall times, the scene's own units for
     ``time_step``, ``horizon`` and the metrics).
 
-    ``status`` is the verdict: the run's outcome (ok / diverged / crashed / timed_out /
-    unsupported) after the harness's own guards (non-finite values, energy growth, escape);
-    ``engine_status`` is what the engine or worker reported before those guards.
+    ``status`` is the run's status (ok / diverged / crashed / timed_out / unsupported) after
+    the harness's own checks of the trajectory (non-finite values, tunnelling, escape);
+    ``engine_status`` is what the engine or worker reported before them; ``verdict`` the
+    run's verdict from its status and expectations (a key of
+    :data:`clearbench.harness.measure.verdicts.VERDICTS`). ``key`` is the run key (what
+    determines the trajectory), ``measure_key`` what determines the measurement
+    (:attr:`~clearbench.harness.run.spec.RunSpec.measure_key`).
     """
 
     key: str
@@ -91,6 +102,8 @@ class RunRecord:
     capabilities: str            # JSON: feature -> [support, detail]
     verdict_reason: str
     metrics_error: str
+    verdict: str
+    measure_key: str
     git_revision: str
     git_dirty: int
     hostname: str
@@ -101,22 +114,13 @@ class RunRecord:
     trajectory: str              # path relative to the store, "" when none
 
     @classmethod
-    def from_worker(cls, spec: RunSpec, ran: dict, measured: dict, revision: dict,
-                    machine: dict) -> RunRecord:
-        """Assemble a row from the spec and the worker's two messages."""
-        guarded = ran.get("status", RunStatus.CRASHED.value)
-        engine_status = ran.get("engine_status", guarded)
-        status = measured.get("verdict") or guarded
-        message = ran.get("message", "")
-        if measured.get("verdict") and measured["verdict"] != guarded:
-            message = measured.get("verdict_reason", "") or message
-        stepping = float(ran.get("stepping_seconds", math.nan))
-        steps = int(ran.get("steps", 0) or 0)
+    def from_messages(cls, spec: RunSpec, ran: RanMessage, measured: MeasuredMessage,
+                      revision: dict, machine: dict) -> RunRecord:
+        """Assemble a row from the spec and the worker's two messages (:mod:`.messages`)."""
+        stepping = float(ran.stepping_seconds)
+        steps = int(ran.steps or 0)
         simulated = steps * spec.time_step
-        figures = measured.get("figures", {}) or {}
-        results = measured.get("expectations", []) or []
-        judged = [r.get("passed") for r in results if r.get("passed") is not None]
-        return cls(
+        record = cls(
             key=spec.key,
             recorded_utc=datetime.now(UTC).isoformat(timespec="seconds"),
             campaign=spec.campaign,
@@ -125,32 +129,34 @@ class RunRecord:
             scene_source=json.dumps(spec.source.to_dict(), sort_keys=True),
             engine=spec.engine.name,
             preset=spec.engine.preset,
-            engine_version=str(ran.get("engine_version", "")),
+            engine_version=str(ran.engine_version),
             time_step=float(spec.time_step),
             horizon=float(spec.horizon),
             record_every=int(spec.record_every),
             options=json.dumps(spec.options_dict, sort_keys=True),
             timeout=float(spec.timeout),
-            status=status,
-            message=message,
-            engine_status=engine_status,
-            engine_message=ran.get("engine_message", ran.get("message", "")),
-            worker_seconds=float(ran.get("worker_seconds", math.nan)),
-            build_seconds=float(ran.get("build_seconds", math.nan)),
+            status=ran.status,
+            message=ran.message,
+            engine_status=ran.status,
+            engine_message=ran.message,
+            worker_seconds=float(ran.worker_seconds),
+            build_seconds=float(ran.build_seconds),
             stepping_seconds=stepping,
             steps=steps,
-            samples=int(ran.get("samples", 0) or 0),
+            samples=int(ran.samples or 0),
             stepping_seconds_per_simulated_second=(
                 stepping / simulated if simulated > 0 else math.nan),
             stepping_seconds_per_step=stepping / steps if steps > 0 else math.nan,
-            error=float(figures.get("error", math.nan)),
-            error_source=measured.get("error_source", ""),
-            expectations_passed=None if not judged else int(all(judged)),
-            metrics=json.dumps(figures, sort_keys=True),
-            expectations=json.dumps(results, sort_keys=True),
-            capabilities=json.dumps(ran.get("capabilities", {}), sort_keys=True),
-            verdict_reason=measured.get("verdict_reason", ""),
-            metrics_error=measured.get("metrics_error", ""),
+            error=math.nan,
+            error_source="",
+            expectations_passed=None,
+            metrics="{}",
+            expectations="[]",
+            capabilities=json.dumps(ran.capabilities, sort_keys=True),
+            verdict_reason="",
+            metrics_error="",
+            verdict="",
+            measure_key="",
             git_revision=revision["revision"],
             git_dirty=int(revision["dirty"]),
             hostname=machine["hostname"],
@@ -160,6 +166,32 @@ class RunRecord:
             clearbench_version=clearbench.__version__,
             trajectory="",
         )
+        return record.measured(measured, spec.measure_key)
+
+    def measured(self, measured: MeasuredMessage, measure_key: str) -> RunRecord:
+        """This row with the measurement ``measured`` (keyed ``measure_key``): the run's
+        status (the engine's when nothing was measured), its message (the reason of the
+        harness's checks where they changed the status), figures, expectations and verdict."""
+        status = measured.status or self.engine_status
+        message = self.engine_message
+        if measured.status and measured.status != self.engine_status:
+            message = measured.reason or message
+        figures = measured.figures or {}
+        results = measured.expectations or []
+        judged = [r.get("passed") for r in results if r.get("passed") is not None]
+        passed = None if not judged else int(all(judged))
+        return dataclasses.replace(
+            self, status=status, message=message,
+            error=float(figures.get("error", math.nan)), error_source=measured.error_source,
+            expectations_passed=passed, metrics=json.dumps(figures, sort_keys=True),
+            expectations=json.dumps(results, sort_keys=True),
+            verdict_reason=measured.reason, metrics_error=measured.metrics_error,
+            verdict=run_verdict(status, passed), measure_key=measure_key)
+
+    @classmethod
+    def from_row(cls, row: dict) -> RunRecord:
+        """The record of a stored row (:meth:`ResultsStore.get`)."""
+        return cls(**{name: row[name] for name in COLUMNS})
 
 
 _SQL_TYPES = {"str": "TEXT", "float": "REAL", "int": "INTEGER", "int | None": "INTEGER"}
@@ -207,6 +239,19 @@ def machine_info() -> dict:
             "python": platform.python_version()}
 
 
+def _migrate_from_1(connection: sqlite3.Connection) -> str:
+    """Add the columns of version 2 (``verdict``, ``measure_key``) to a version-1 store;
+    returns the new version. Its runs keep their keys (computed by other rules: none matches
+    a run asked for now)."""
+    present = {row[1] for row in connection.execute("PRAGMA table_info(runs)")}
+    for name in ("verdict", "measure_key"):
+        if name not in present:
+            connection.execute(f"ALTER TABLE runs ADD COLUMN {name} TEXT DEFAULT ''")
+    connection.execute("UPDATE meta SET value = ? WHERE name = 'schema_version'",
+                       (str(SCHEMA_VERSION),))
+    return str(SCHEMA_VERSION)
+
+
 class ResultsStore:
     """A results store in ``directory`` (created when missing)."""
 
@@ -223,6 +268,8 @@ class ResultsStore:
                                (str(SCHEMA_VERSION),))
             version = connection.execute(
                 "SELECT value FROM meta WHERE name = 'schema_version'").fetchone()[0]
+            if int(version) == 1:
+                version = _migrate_from_1(connection)
         if int(version) != SCHEMA_VERSION:
             raise ValueError(f"{self.path}: store schema version {version}, this clearbench "
                              f"reads version {SCHEMA_VERSION}")
@@ -295,10 +342,30 @@ class ResultsStore:
     def reusable_keys(self) -> set[str]:
         """Keys of the runs a sweep may serve from the store instead of running them: every
         run but a crashed one (:data:`RERUN_STATUSES`)."""
+        return set(self.reusable())
+
+    def reusable(self) -> dict[str, str]:
+        """Run key -> measurement key of the runs a sweep may serve from the store instead of
+        running them: every run but a crashed one (:data:`RERUN_STATUSES`). A run whose
+        measurement key is not the one asked for is measured again from its trajectory."""
         marks = ", ".join("?" for _ in RERUN_STATUSES)
         with self._connect() as connection:
-            return {row[0] for row in connection.execute(
-                f"SELECT key FROM runs WHERE status NOT IN ({marks})", RERUN_STATUSES)}
+            return {row[0]: row[1] for row in connection.execute(
+                f"SELECT key, measure_key FROM runs WHERE status NOT IN ({marks})",
+                RERUN_STATUSES)}
+
+    def remeasure(self, record: RunRecord) -> None:
+        """Replace the measurement of the stored run ``record.key`` by ``record``'s (status,
+        message, figures, expectations, verdict, measurement key), its run and trajectory
+        kept."""
+        names = ("status", "message", "error", "error_source", "expectations_passed",
+                 "metrics", "expectations", "verdict_reason", "metrics_error", "verdict",
+                 "measure_key")
+        row = asdict(record)
+        with self._connect() as connection:
+            connection.execute(
+                f"UPDATE runs SET {', '.join(f'{name} = ?' for name in names)} WHERE key = ?",
+                [row[name] for name in names] + [record.key])
 
     def __len__(self) -> int:
         with self._connect() as connection:

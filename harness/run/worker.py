@@ -1,18 +1,26 @@
 """The worker process: runs one scene in one engine, then measures the trajectory.
 
-A worker is started by :mod:`.runner` with the ``spawn`` context, receives JSON-able requests on
-a pipe and answers each with two messages: ``ran`` (outcome, wall times, trajectory written to
-the given .npz path) and then ``measured`` (metrics, expectations, verdict). The parent applies
-the wall-clock limit to the first phase and a separate limit to the second, so that a metric
-that is slow or crashes never hides the run's own outcome.
+A worker is started by :mod:`.runner` with the ``spawn`` context, receives
+:class:`~.messages.WorkerRequest` objects on a pipe and answers each with two messages: a
+:class:`~.messages.RanMessage` (the engine's outcome and wall times, the trajectory written to
+the given .npz path) and then a :class:`~.messages.MeasuredMessage` (figures, expectations and
+the run's status after the harness's checks). The parent applies the wall-clock limit to the
+first phase and a separate limit to the second, so that a metric that is slow or crashes never
+hides the run's own outcome. A request that only measures (a stored trajectory whose measuring
+code changed) gets the second message alone.
 
-Nothing here trusts the engine: an exception is a crashed run with its message, and a
-trajectory with non-finite values is a diverged run whatever status the engine gave.
+Nothing here trusts the engine: an exception is a crashed run with its message, and the
+measuring phase decides the run's status (:func:`measure_phase`: a trajectory with non-finite
+values is a diverged run whatever status the engine gave). The run phase only hands the spec
+to the engine, so the trajectory depends on the physics sources alone
+(:data:`clearbench.PHYSICS_SUBPACKAGES`); this module's measuring phase is a measuring source
+(:data:`clearbench.MEASURING_SOURCES`).
 """
 
 from __future__ import annotations
 
 import ctypes
+import dataclasses
 import importlib
 import logging
 import os
@@ -21,9 +29,11 @@ import time
 import traceback
 from pathlib import Path
 
-from clearbench.adapters.base import RunSettings
+from clearbench.adapters.base import Capability, RunSettings, Support
 from clearbench.adapters.trajectory import RunStatus, Trajectory
 from clearbench.harness.measure.figures import first_non_finite, measure
+from clearbench.harness.run.messages import MeasuredMessage, RanMessage, WorkerRequest
+from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.serialization import scene_from_dict
 
 LOG = logging.getLogger(__name__)
@@ -61,6 +71,9 @@ def worker_main(conn, parent_pid: int) -> None:
             return
         if request is None:
             return
+        if request.measure_only:
+            conn.send(measure_stored(request))
+            continue
         ran, scene, trajectory = run_phase(request)
         conn.send(ran)
         conn.send(measure_phase(request, scene, trajectory))
@@ -72,83 +85,86 @@ def _exception_message(error: BaseException) -> str:
     return f"{type(error).__name__}: {error}{where}"
 
 
-def run_phase(request: dict):
-    """Build the scene and engine, run, guard, save the trajectory.
+def run_phase(request: WorkerRequest) -> tuple[RanMessage, Scene | None, Trajectory | None]:
+    """Build the scene and engine, run, save the trajectory.
 
     Returns
     -------
-    ran : dict
-        ``phase``, ``status`` (RunStatus value), ``message``, ``engine_version``,
-        ``capabilities`` (feature -> [support, detail]), ``worker_seconds`` (whole phase [s]),
-        ``build_seconds``, ``stepping_seconds``, ``steps``, ``samples``, ``trajectory_saved``.
+    ran : RanMessage
+        The engine's outcome as it reported it (crashed, with the exception, when the engine
+        or the adapter raised).
     scene, trajectory
         For the measuring phase (``trajectory`` None when the engine raised).
     """
     start = time.perf_counter()
-    ran = {"phase": "ran", "status": RunStatus.CRASHED.value, "message": "",
-           "engine_version": "", "capabilities": {}, "worker_seconds": 0.0,
-           "build_seconds": float("nan"), "stepping_seconds": float("nan"), "steps": 0,
-           "samples": 0, "trajectory_saved": False}
     scene = None
     trajectory = None
     try:
-        scene = scene_from_dict(request["scene"])
-        module = importlib.import_module(request["module"])
-        ran["engine_version"] = str(module.availability()[1])
-        engine = module.create(request["preset"])
-        ran["capabilities"] = {
-            feature: [capability.support.value, capability.detail]
-            for feature, capability in sorted(engine.capabilities(scene).items())
-        }
-        settings = RunSettings(time_step=request["time_step"], horizon=request["horizon"],
-                               record_every=request["record_every"],
-                               options=dict(request["options"]))
-        trajectory = engine.run(scene, settings)
-        status, message = trajectory.status, trajectory.message
-        ran["engine_status"], ran["engine_message"] = status.value, message
-        if status is RunStatus.OK:
-            bad = first_non_finite(trajectory)
-            if bad is not None:
-                status, message = RunStatus.DIVERGED, bad
-                trajectory.status, trajectory.message = status, message
-        ran.update(status=status.value, message=message,
-                   build_seconds=float(trajectory.build_seconds),
-                   stepping_seconds=float(trajectory.stepping_seconds),
-                   steps=int(trajectory.steps), samples=int(len(trajectory.times)))
-        path = Path(request["trajectory_path"])
+        scene = scene_from_dict(request.scene)
+        engine = importlib.import_module(request.module).create(request.preset)
+        capabilities = {feature: Capability(Support(support), detail)
+                        for feature, (support, detail) in request.capabilities.items()}
+        settings = RunSettings(time_step=request.time_step, horizon=request.horizon,
+                               record_every=request.record_every, options=dict(request.options))
+        trajectory = engine.run(scene, settings, capabilities=capabilities)
+        path = Path(request.trajectory_path)
         partial = path.with_name(path.name + ".partial.npz")
         trajectory.save(partial)
         os.replace(partial, path)
-        ran["trajectory_saved"] = True
+        ran = RanMessage(status=trajectory.status.value, message=trajectory.message,
+                         engine_version=request.engine_version,
+                         capabilities=request.capabilities,
+                         build_seconds=float(trajectory.build_seconds),
+                         stepping_seconds=float(trajectory.stepping_seconds),
+                         steps=int(trajectory.steps), samples=int(len(trajectory.times)),
+                         trajectory_saved=True)
     except Exception as error:  # an engine or adapter bug is a recorded outcome
         LOG.debug("run raised", exc_info=True)
-        ran["status"] = RunStatus.CRASHED.value
-        ran["message"] = _exception_message(error)
+        ran = RanMessage(status=RunStatus.CRASHED.value, message=_exception_message(error),
+                         engine_version=request.engine_version,
+                         capabilities=request.capabilities)
         trajectory = None
-    ran["worker_seconds"] = time.perf_counter() - start
-    return ran, scene, trajectory
+    return dataclasses.replace(ran, worker_seconds=time.perf_counter() - start), scene, \
+        trajectory
 
 
-def measure_phase(request: dict, scene, trajectory: Trajectory | None) -> dict:
-    """Metrics, expectations and verdict of a finished run
-    (:func:`clearbench.harness.measure.figures.measure`)."""
+def measure_phase(request: WorkerRequest, scene: Scene | None,
+                  trajectory: Trajectory | None) -> MeasuredMessage:
+    """The run's status, figures, expectations and verdict from its trajectory: the one place
+    the run's status is decided (:mod:`.messages`). A trajectory the engine called ok with a
+    non-finite value is diverged; then :func:`clearbench.harness.measure.figures.measure`
+    (whose checks may find it diverged too)."""
     start = time.perf_counter()
-    out = {"phase": "measured", "figures": {}, "expectations": [], "verdict": None,
-           "verdict_reason": "", "error_source": "", "metrics_error": ""}
     if trajectory is None or scene is None:
-        out["seconds"] = time.perf_counter() - start
-        return out
+        return MeasuredMessage(seconds=time.perf_counter() - start)
+    status, reason = trajectory.status, ""
+    if status is RunStatus.OK:
+        bad = first_non_finite(trajectory)
+        if bad is not None:
+            status, reason = RunStatus.DIVERGED, bad
+            trajectory.status, trajectory.message = status, bad
+    out = MeasuredMessage(status=status.value, reason=reason)
     try:
         reference = None
-        if request.get("reference_path"):
-            reference = Trajectory.load(request["reference_path"])
+        if request.reference_path:
+            reference = Trajectory.load(request.reference_path)
         result = measure(scene, trajectory, reference,
-                         request.get("reference_label") or "reference trajectory")
-        out.update(figures=result.figures, expectations=list(result.expectations),
-                   verdict=result.verdict.value, verdict_reason=result.verdict_reason,
-                   error_source=result.error_source, metrics_error=result.metrics_error)
+                         request.reference_label or "reference trajectory")
+        out = MeasuredMessage(status=result.verdict.value,
+                              reason=result.verdict_reason or reason, figures=result.figures,
+                              expectations=list(result.expectations),
+                              error_source=result.error_source,
+                              metrics_error=result.metrics_error)
     except Exception as error:
         LOG.debug("metrics raised", exc_info=True)
-        out["metrics_error"] = _exception_message(error)
-    out["seconds"] = time.perf_counter() - start
-    return out
+        out = dataclasses.replace(out, metrics_error=_exception_message(error))
+    return dataclasses.replace(out, seconds=time.perf_counter() - start)
+
+
+def measure_stored(request: WorkerRequest) -> MeasuredMessage:
+    """:func:`measure_phase` of the trajectory stored at ``request.trajectory_path`` (an
+    empty measurement when there is none)."""
+    path = Path(request.trajectory_path)
+    if not path.exists():
+        return MeasuredMessage()
+    return measure_phase(request, scene_from_dict(request.scene), Trajectory.load(path))

@@ -43,6 +43,7 @@ import numpy as np
 
 from clearbench.adapters.trajectory import RunStatus
 from clearbench.harness.run.engine_choice import RunInputError, resolve_engine
+from clearbench.harness.run.messages import MeasuredMessage, RanMessage
 from clearbench.harness.run.runner import MANY_RUNS_PER_WORKER, Runner
 from clearbench.harness.run.spec import DEFAULT_TIMEOUT, RunSpec, make_run_spec
 from clearbench.harness.run.store import ResultsStore, RunRecord, machine_info, revision_info
@@ -287,9 +288,10 @@ def _record(store: ResultsStore, sample: CampaignSample, result: dict) -> RunRec
 
 def _lost_run(sample: CampaignSample, error: BaseException) -> dict:
     """The row of a sample whose Dask task failed (e.g. it killed its workers every time)."""
-    ran = {"status": RunStatus.CRASHED.value,
-           "message": f"Dask task failed: {type(error).__name__}: {error}"}
-    record = RunRecord.from_worker(sample.spec, ran, {}, revision_info(), machine_info())
+    ran = RanMessage(status=RunStatus.CRASHED.value,
+                     message=f"Dask task failed: {type(error).__name__}: {error}")
+    record = RunRecord.from_messages(sample.spec, ran, MeasuredMessage(), revision_info(),
+                                     machine_info())
     return {"row": asdict(record), "trajectory": None}
 
 
