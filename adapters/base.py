@@ -39,6 +39,7 @@ from typing import Any, ClassVar
 
 from clearbench.adapters.options import OptionTable
 from clearbench.adapters.recording import step_count
+from clearbench.adapters.stepping import StepRunner, step_loop
 from clearbench.adapters.trajectory import RunStatus, Trajectory
 from clearbench.scenarios.features import FeatureKind, parse_feature
 from clearbench.scenarios.scene import Scene
@@ -337,16 +338,23 @@ class BuildError(Exception):
 
 
 class SteppingEngine(ModuleEngine):
-    """A :class:`ModuleEngine` that steps in this process. The base does the bookkeeping of a
-    run (scipy's ``OdeSolver.step`` / ``_step_impl`` model): settings resolved once, the scene
-    in the engine's internal units, step and horizon converted to them, build and stepping
-    timed apart, the recorded samples converted back into a :class:`Trajectory`. The engine
-    supplies the hooks :meth:`build`, :meth:`runner` and :meth:`metadata` (and, where it needs
-    them, :meth:`internal_scene`, :meth:`step`, :meth:`release`, :meth:`steps_taken`).
+    """A :class:`ModuleEngine` that steps in this process: the one template of a new engine
+    (docs/engines/adding.md). The base does the bookkeeping of a run (scipy's
+    ``OdeSolver.step`` / ``_step_impl`` model): settings resolved once, the scene in the
+    engine's internal units, step and horizon converted to them, build and stepping timed
+    apart, the step loop (:func:`~clearbench.adapters.stepping.step_loop`: steps taken,
+    recording cadence, guards, divergence), the recorded samples converted back into a
+    :class:`Trajectory`. The engine supplies the hooks :meth:`build`, :meth:`runner` (its
+    :class:`~clearbench.adapters.stepping.StepRunner`: what one step, a state read-out and a
+    contact read-out are for it) and :meth:`metadata` (and, where it needs them,
+    :meth:`internal_scene`, :meth:`release`, :meth:`steps_taken`, :meth:`rebuild_overlap`).
 
-    The runner a hook returns has ``run() -> (RunStatus, message)`` and a ``monitor``
-    (:class:`~clearbench.adapters.step_monitor.StepMonitor`: recorder, guards, unconverged
-    steps, stepping time, steps taken), whose statistics fill the trajectory's typed fields.
+    Two engines keep a driver of their own, outside this template: the reference solver,
+    whose whole time loop is compiled (numba; a Python runner called once per step would
+    cost it more than its step, and its Python step loop is the compiled loop's oracle,
+    :mod:`clearbench.adapters.reference.run`), and Siconos, which steps in a worker process
+    under Debian's interpreter that cannot import clearbench (:mod:`clearbench.adapters.siconos`):
+    both implement :meth:`Engine._run` and return the trajectory.
     """
 
     #: The engine's name in prose (``"MuJoCo"``), for notes of the run.
@@ -368,7 +376,7 @@ class SteppingEngine(ModuleEngine):
         try:
             runner = self.runner(internal, built, config, steps, settings.record_every)
             build_seconds = time.perf_counter() - start
-            status, message = self.step(runner)
+            status, message = step_loop(runner, steps)
         finally:
             self.release(built)
         monitor = runner.monitor
@@ -397,8 +405,10 @@ class SteppingEngine(ModuleEngine):
         when the engine refuses it."""
 
     @abstractmethod
-    def runner(self, internal: Scene, built, config, steps: int, record_every: int) -> Any:
-        """The step loop of the run (see the class docstring)."""
+    def runner(self, internal: Scene, built, config, steps: int,
+               record_every: int) -> StepRunner:
+        """The engine's runner of this run (``Runner(internal, built, config, steps,
+        record_every)`` of its ``run.py``)."""
 
     @abstractmethod
     def metadata(self, scene: Scene, internal: Scene, config, built, runner) -> dict:
@@ -409,10 +419,6 @@ class SteppingEngine(ModuleEngine):
         rebuilt shapes only touch [internal length] (:attr:`Trajectory.rebuild_overlap`;
         default: the built model's ``rebuild_overlap`` mapping, or every pair exact)."""
         return getattr(built, "rebuild_overlap", {})
-
-    def step(self, runner) -> tuple[RunStatus, str]:
-        """Run the loop; (status, message) of its end."""
-        return runner.run()
 
     def release(self, built) -> None:
         """Free what the model holds outside Python (default: nothing)."""

@@ -1,6 +1,6 @@
 """The bookkeeping after each step of a run, shared by every stepping engine.
 
-An engine's step loop (a Python loop over the engine's step call, or the engine's own callback
+The step loop (:func:`clearbench.adapters.stepping.step_loop`, or the engine's own callback
 after each of its steps, as Exudyn's) calls one :class:`StepMonitor`: it records the due
 samples (:class:`~clearbench.adapters.recording.SampleRecorder`), checks that the state is
 finite, runs the energy guard (:class:`~clearbench.adapters.energy_guard.EnergyGuard`), keeps
@@ -74,7 +74,8 @@ class StepMonitor:
         Parameters
         ----------
         read_state : callable
-            The current state as a sequence of arrays (read only when needed).
+            The current state as a sequence of arrays (None parts skipped; read only when
+            needed).
         energy : callable
             (total, kinetic) mechanical energy of a state [internal energy unit].
         store : callable
@@ -92,7 +93,7 @@ class StepMonitor:
         state = None
         if problem is None and (recording or checking):
             state = read_state()
-            if not all(np.isfinite(part).all() for part in state):
+            if not all(np.isfinite(part).all() for part in state if part is not None):
                 problem = f"non-finite state at step {step} (t = {time:.6g})"
             elif self.guard.applies:
                 problem = self.guard.check(*energy(state), time)

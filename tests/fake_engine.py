@@ -1,4 +1,8 @@
-"""A tiny engine following the adapter contract, for the harness tests.
+"""A tiny engine following the adapter contract, for the harness tests: a bare
+:class:`~clearbench.adapters.base.Engine` on purpose, not the template of a new engine (that is
+:class:`~clearbench.adapters.base.SteppingEngine`, followed by ``tests/toy_engine``): the
+shared step loop's guards would catch its misbehaviour themselves, while the harness must catch
+an engine that crashes, hangs or returns NaN with an ok status on its own.
 
 It integrates free flight only (gravity, constant angular velocity; contacts and joints ignored)
 with the symplectic Euler method, so its error against the exact ballistic motion is O(dt).

@@ -63,7 +63,7 @@ class DrakeEngine(SteppingEngine):
                record_every: int):
         from clearbench.adapters.drake.run import Runner
 
-        return Runner(built, steps, record_every)
+        return Runner(internal, built, config, steps, record_every)
 
     def metadata(self, scene: Scene, internal: Scene, config: DrakeSettings, built,
                  runner) -> dict:

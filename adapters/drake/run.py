@@ -1,8 +1,8 @@
-"""The step loop of a Drake run: drivers, loads, guards, read-out into trajectory arrays.
+"""One Drake run as the shared step loop drives it (:mod:`clearbench.adapters.stepping`):
+drivers, loads, guards, read-out into trajectory samples.
 
-Works on a plant built by :mod:`.build` (SI) and records with
-:class:`~clearbench.adapters.recording.SampleRecorder` (the engine converts the samples back to
-the scene's units). Each step is ``Simulator.AdvanceTo`` of one period of the discrete plant.
+Works on a plant built by :mod:`.build` (SI; the engine converts the samples back to the
+scene's units). Each step is ``Simulator.AdvanceTo`` of one period of the discrete plant.
 
 - Drivers: the driven coordinate is reset to its profile (position, rate) at each step start;
   the actuator's reflected inertia holds it during the step.
@@ -24,41 +24,30 @@ iterations, residual NaN and "converged" (a solver failure raises and stops the 
 
 from __future__ import annotations
 
-import logging
-import time
-
 import numpy as np
 from pydrake.multibody.math import SpatialForce
 from pydrake.multibody.plant import ExternallyAppliedSpatialForce
 
 from clearbench.adapters.drake.build import BuiltPlant
-from clearbench.adapters.energy_guard import EnergyGuard
-from clearbench.adapters.step_monitor import StepMonitor
+from clearbench.adapters.drake.settings import DrakeSettings
+from clearbench.adapters.stepping import BodyState, ContactForces, StepFailure, StepRunner
 from clearbench.adapters.trajectory import RunStatus
 from clearbench.kernels.quaternion import quat_normalize, quat_to_matrix
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.energy import mechanical_energy, rigid_spring_points
-
-logger = logging.getLogger(__name__)
+from clearbench.scenarios.scene import Scene
 
 __all__ = ["Runner"]
 
 
-class Runner:
-    """The step loop of one run: drivers, loads, guards, and sampling into arrays."""
+class Runner(StepRunner):
+    """Drivers, loads, guards and read-out of one run (see the module docstring)."""
 
-    def __init__(self, built: BuiltPlant, steps: int, record_every: int):
-        self.built = built
+    def __init__(self, scene: Scene, built: BuiltPlant, config: DrakeSettings, steps: int,
+                 record_every: int):
+        super().__init__(scene, built, config, steps, record_every)
         self.plant = built.plant
         self.context = built.plant_context
-        self.scene = scene = built.scene
-        self.config = built.settings
-        self.steps = steps
-        self.dt = built.time_step
-        self.monitor = StepMonitor(scene, steps, record_every, EnergyGuard(
-            scene, self.config.energy_gain_tolerance, self.config.guard_interval,
-            counts_torsional_springs=False))
-        self.time = 0.0
         self.max_contacts = 0
         self.penetration_max = 0.0
         self._handles = [built.bodies.get(b.name) for b in scene.bodies]
@@ -79,7 +68,10 @@ class Runner:
             self._force_port.FixValue(self.context, [])
 
     # ------------------------------------------------------------------ state
-    def body_state(self):
+    def read_state(self) -> BodyState:
+        return self.body_state()
+
+    def body_state(self) -> BodyState:
         """Body-frame positions (nb, 3) and quaternions (nb, 4), centre-of-mass velocities
         (nb, 3, world), angular velocities (nb, 3, BODY axes), centres of mass (nb, 3) and
         body rotations (nb, 3, 3)."""
@@ -104,16 +96,16 @@ class Runner:
             velocity[i] = twist.translational() + np.cross(omega, rotation[i] @ self._com_local[i])
             omega_body[i] = rotation[i].T @ omega
         com = position + np.einsum("bij,bj->bi", rotation, self._com_local)
-        return position, quaternion, velocity, omega_body, com, rotation
+        return BodyState(position, quaternion, velocity, omega_body, com, rotation)
 
-    def energy(self, state) -> tuple[float, float]:
+    def energy(self, state: BodyState) -> tuple[float, float]:
         """(total, kinetic) mechanical energy of ``state`` (:meth:`body_state`), SI."""
         position, _, velocity, omega, com, rotation = state
         energy = mechanical_energy(self.scene, com, velocity, omega,
                                    rigid_spring_points(self.scene, position, rotation))
         return float(energy.total), float(energy.kinetic)
 
-    # ------------------------------------------------------------------ loop
+    # ------------------------------------------------------------------ steps
     def apply_inputs(self, k: int) -> None:
         """Drivers reset to their profile and loads evaluated at the start of step ``k``."""
         for joint, position, rate, rotation in self._drive:
@@ -140,37 +132,24 @@ class Runner:
             applied.append(force)
         self._force_port.FixValue(self.context, applied)
 
-    def run(self) -> tuple[RunStatus, str]:
-        """Step the run, sampling into the monitor; (status, message) of its end."""
-        monitor = self.monitor
-        simulator = self.built.simulator
-        state = self.body_state()
-        self.store(state)
-        monitor.guard.start(*self.energy(state))
-        simulator.Initialize()
-        for k in range(1, self.steps + 1):
-            tick = time.perf_counter()
-            problem = None
-            try:
-                self.apply_inputs(k)
-                simulator.AdvanceTo(k * self.dt)
-            except RuntimeError as error:
-                problem = f"Drake stopped at step {k} (t = {k * self.dt:.6g} s): {error}"
-            monitor.stepping_seconds += time.perf_counter() - tick
-            self.time = k * self.dt
-            if problem is not None:
-                logger.info("%s: %s", self.scene.name, problem)
-                return RunStatus.DIVERGED, problem
-            monitor.steps_taken = k
-            problem = monitor.after_step(k, self.time, self.body_state, self.energy,
-                                         lambda state: self.store(state, self.contact_forces()))
-            if problem is not None:
-                logger.info("%s: stopped: %s", self.scene.name, problem)
-                return RunStatus.DIVERGED, problem
-        return RunStatus.OK, ""
+    def start(self) -> None:
+        self.built.simulator.Initialize()
+
+    def advance(self, step: int) -> StepFailure | None:
+        """The inputs of the step start, then ``AdvanceTo`` its end; a RuntimeError of Drake's
+        solver stops the run as diverged, with Drake's message (its state is not kept)."""
+        try:
+            self.apply_inputs(step)
+            self.built.simulator.AdvanceTo(step * self.dt)
+        except RuntimeError as error:
+            return StepFailure(RunStatus.DIVERGED, f"Drake stopped at step {step} "
+                               f"(t = {step * self.dt:.6g} s): {error}")
+        finally:
+            self.time = step * self.dt
+        return None
 
     # ------------------------------------------------------------------ read-out
-    def contact_forces(self) -> tuple[np.ndarray, np.ndarray, int]:
+    def contact_forces(self) -> ContactForces:
         """Per scene pair: normal force sum (npair,) and total force on scene body B, world
         (npair, 3), of the step just taken; and the number of points with a normal force."""
         npair = len(self.scene.all_contacts)
@@ -212,11 +191,4 @@ class Runner:
             normal[index] += normal_force
             total[index] += force_on_m if drake_m_side == "b" else -force_on_m
         self.max_contacts = max(self.max_contacts, active)
-        return normal, total, active
-
-    def store(self, state, forces: tuple | None = None) -> None:
-        """Record ``state`` (from :meth:`body_state`) as the next sample, with the step's
-        contact ``forces`` (from :meth:`contact_forces`) when given."""
-        position, orientation, velocity, omega, _, _ = state
-        self.monitor.recorder.store(self.time, position, orientation, velocity, omega,
-                                    contacts=forces)
+        return ContactForces(normal, total, active)

@@ -17,10 +17,10 @@ regularised: a body that must stick creeps at up to that speed (the "stiction-to
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 
-from clearbench.adapters.options import OptionError, OptionTable, boolean, choice, integer, number
+from clearbench.adapters.engine_settings import GUARD_OPTIONS, EngineSettings
+from clearbench.adapters.options import OptionError, OptionTable, boolean, choice, number
 from clearbench.adapters.primitive_pieces import PIECE_OPTIONS, PieceSettings
 
 #: Drake's own MultibodyPlantConfig defaults (pydrake 1.51: ``MultibodyPlantConfig()``).
@@ -57,7 +57,7 @@ PRESETS: dict[str, dict] = {
 
 
 @dataclass(frozen=True)
-class DrakeSettings(PieceSettings):
+class DrakeSettings(PieceSettings, EngineSettings):
     """Every option of a Drake run (lengths in the model's internal units, SI).
 
     Attributes
@@ -98,11 +98,8 @@ class DrakeSettings(PieceSettings):
     driver_armature_ratio : float
         Reflected inertia of a driven joint relative to its body's inertia (the coordinate is
         reset to its profile at each step start; the armature holds it during the step).
-    energy_gain_tolerance : float
-        Energy above its initial value by more than this fraction of the energy scale stops the
-        run as diverged, on scenes whose energy may only decrease.
-    guard_interval : int
-        Steps between energy checks (also checked at every recorded sample).
+    energy_gain_tolerance, guard_interval
+        The shared energy guard (:class:`~clearbench.adapters.engine_settings.EngineSettings`).
     adjacent_bodies_collision_filters : bool
         Drake's filter of contacts between bodies joined by a joint. The adapter sets False by
         default: the scene names the pairs that collide, and a pair between joined bodies is
@@ -121,23 +118,18 @@ class DrakeSettings(PieceSettings):
     sap_near_rigid_threshold: float = 1.0
     hydroelastic_boxes: bool = False
     driver_armature_ratio: float = 1e6
-    energy_gain_tolerance: float = 0.1
-    guard_interval: int = 10
     adjacent_bodies_collision_filters: bool = False
     #: Units of the Drake model (not an option): Drake's defaults (penetration allowance,
     #: stiction tolerance, relaxation time) are absolute SI values.
     internal_units: str = "SI"
 
     def __post_init__(self) -> None:
-        OPTIONS.check_settings(self)
+        super().__post_init__()
         if self.hydroelastic_boxes and self.contact_model == "point":
             raise OptionError("drake", "hydroelastic_boxes", True,
                               "needs contact_model 'hydroelastic_with_fallback' (with 'point' "
                               "Drake ignores hydroelastic properties)")
 
-    def as_dict(self) -> dict:
-        """Plain-dict form for trajectory metadata."""
-        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
 
     @property
     def uses_sap_dissipation(self) -> bool:
@@ -160,10 +152,10 @@ OPTIONS = OptionTable("drake", (
     boolean("hydroelastic_boxes"),
     *PIECE_OPTIONS,
     number("driver_armature_ratio", above=0.0),
-    number("energy_gain_tolerance", above=0.0),
-    integer("guard_interval", at_least=1),
+    *GUARD_OPTIONS,
     boolean("adjacent_bodies_collision_filters"),
 ))
+DrakeSettings.OPTIONS = OPTIONS
 
 
 def resolve_settings(preset: str, options: dict | None = None) -> DrakeSettings:

@@ -1,8 +1,12 @@
-"""The step loop of an Exudyn run: solver settings, recording, guards, read-out.
+"""One Exudyn run as the shared step loop drives it (:mod:`clearbench.adapters.stepping`):
+solver settings, recording, guards, read-out.
 
-Exudyn is stepped by its own ``MainSolverImplicitSecondOrder`` (``InitializeSolver``,
-``SolveSteps``, ``FinalizeSolver``). Option ``step_loop``: 'horizon' makes one
-``SolveSteps`` call over the whole run, as ``exu.SolveDynamic`` does, and leaves Exudyn's step
+Exudyn is stepped by its own ``MainSolverImplicitSecondOrder`` (``InitializeSolver`` in
+:meth:`Runner.start`, ``SolveSteps`` in :meth:`Runner.advance`, ``FinalizeSolver`` in
+:meth:`Runner.finish`). Its solver may reduce its step on its own, so the runner reports each
+accepted step to the monitor from Exudyn's PostStep callback (``MONITORS_OWN_STEPS``). Option
+``step_loop``: 'horizon' makes one ``SolveSteps`` call over the whole run (the loop's first
+step; the later ones return at once), as ``exu.SolveDynamic`` does, and leaves Exudyn's step
 control alone: after a step reduced to a contact instant it keeps the short steps through the
 impact and grows them back after ``adaptiveStepRecoverySteps`` good steps; a sample is the
 first step end at or after its time, so sample times can leave the grid by less than a step.
@@ -32,25 +36,21 @@ from __future__ import annotations
 
 import contextlib
 import io
-import logging
 import time
 
 import numpy as np
 
-from clearbench.adapters.energy_guard import EnergyGuard
 from clearbench.adapters.exudyn.build import BuiltSystem, load_exudyn
 from clearbench.adapters.exudyn.failure import failed_loop, failure_reason
 from clearbench.adapters.exudyn.idle_connectors import IdleConnectors, culling_wanted
 from clearbench.adapters.exudyn.settings import ExudynSettings
-from clearbench.adapters.step_monitor import StepMonitor
+from clearbench.adapters.stepping import BodyState, ContactForces, StepFailure, StepRunner
 from clearbench.adapters.trajectory import RunStatus
 from clearbench.kernels.quaternion import quat_from_matrix_batch
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.energy import mechanical_energy, rigid_spring_points
 from clearbench.scenarios.loads import LinearSpringDamper, PointForce
 from clearbench.scenarios.scene import Scene
-
-logger = logging.getLogger(__name__)
 
 #: Exudyn's timers kept in the metadata (``solver.timer``; wall seconds).
 TIMERS = ("jacobianODE2", "jacobianAE", "ODE2RHS", "AERHS", "massMatrix", "factorization",
@@ -98,27 +98,24 @@ def simulation_settings(settings: ExudynSettings, time_step: float, steps: int,
     return s
 
 
-class Runner:
-    """The step loop of one run: recording into arrays and the guards (model units)."""
+class Runner(StepRunner):
+    """Solver settings, callbacks, recording and guards of one run (model units; see the
+    module docstring)."""
+
+    MONITORS_OWN_STEPS = True
 
     def __init__(self, scene: Scene, built: BuiltSystem, config: ExudynSettings, steps: int,
                  record_every: int):
-        self.scene = scene
-        self.built = built
-        self.config = config
-        self.steps = steps
-        self.dt = built.time_step
-        self.monitor = StepMonitor(scene, steps, record_every, EnergyGuard(
-            scene, config.energy_gain_tolerance, config.guard_interval,
-            counts_torsional_springs=False))
+        super().__init__(scene, built, config, steps, record_every)
         self.recorder = self.monitor.recorder
         # Reduced steps make Exudyn's time leave the grid: a sample is the first step end at
         # or after its time.
         self.record_times = np.asarray(self.recorder.schedule, dtype=float) * self.dt
         self.min_normal_force = 0.0
         self.solver_steps = 0
-        self.record_seconds = 0.0
         self.problem: str | None = None
+        self._simulation = None
+        self._finalized = False
         self.captured_stdout = ""
         self.error_string = ""
         self.exudyn_error_string = ""
@@ -157,21 +154,29 @@ class Runner:
         return bodies.euler_parameter_state(data.GetODE2Coordinates(),
                                             data.GetODE2Coordinates_t())
 
-    def energy(self, state=None) -> tuple[float, float]:
-        """(total, kinetic) mechanical energy of ``state`` (default: the current one):
+    def read_state(self) -> BodyState:
+        """:meth:`state` as a :class:`~clearbench.adapters.stepping.BodyState` (rotations
+        kept)."""
+        position, quaternion, rotation, velocity, omega = self.state()
+        return BodyState(position, quaternion, velocity, omega, None, rotation)
+
+    def energy(self, state: BodyState) -> tuple[float, float]:
+        """(total, kinetic) mechanical energy of ``state`` (:meth:`read_state`):
         :func:`~clearbench.scenarios.energy.mechanical_energy` with linear springs (model
         units)."""
-        position, _, rotation, velocity, omega = state or self.state()
+        position, rotation = state.positions, state.rotations
+        velocity, omega = state.velocities, state.angular_velocities
         com = position + np.einsum("bij,bj->bi", rotation, self.built.bodies.com)
         energy = mechanical_energy(self.scene, com, velocity, omega,
                                    rigid_spring_points(self.scene, position, rotation))
         return float(energy.total), float(energy.kinetic)
 
-    def force_scale(self, state=None) -> float:
-        """The scene's force scale [F, model units]: the largest applied force in the current
-        configuration (weights, point forces, linear springs with their preload, the forces of
-        the law loads); moments are left out (a moment has no force scale without a lever)."""
-        position, _, rotation, _, _ = state or self.state()
+    def force_scale(self, state: BodyState) -> float:
+        """The scene's force scale [F, model units]: the largest applied force in the
+        configuration ``state`` (weights, point forces, linear springs with their preload, the
+        forces of the law loads); moments are left out (a moment has no force scale without a
+        lever)."""
+        position, rotation = state.positions, state.rotations
         forces = [self.mass[self.movable] * float(np.linalg.norm(self.gravity))]
         forces += [[float(np.linalg.norm(load.force))] for load in self.scene.loads
                    if isinstance(load, PointForce)]
@@ -188,17 +193,19 @@ class Runner:
         return float(max((np.max(f, initial=0.0) for f in forces), default=0.0))
 
     # ------------------------------------------------------------------ read-out
-    def contact_forces(self) -> tuple[np.ndarray, np.ndarray, int]:
+    def contact_forces(self) -> ContactForces:
         """Per scene pair: normal force sum (npair,) and total force on body B (npair, 3,
         world) of the current state; and the number of connectors in contact (gap < 0, as
-        stored by Exudyn's last PostNewton)."""
+        stored by Exudyn's last PostNewton). Keeps the most negative normal force sum (Exudyn
+        does not clip it at zero)."""
         exu = load_exudyn()
         mbs = self.built.mbs
         npair = len(self.scene.all_contacts)
         normal = np.zeros(npair)
         total = np.zeros((npair, 3))
         if not self.built.connectors:
-            return normal, total, 0
+            self.min_normal_force = min(self.min_normal_force, 0.0)
+            return ContactForces(normal, total, 0)
         gaps = np.asarray(mbs.systemData.GetDataCoordinates())
         active = 0
         for ref in self.built.connectors:
@@ -212,31 +219,26 @@ class Runner:
             active += 1
             normal[ref.pair] += -float(force @ n0)  # Force acts on the sphere; n0 points away
             total[ref.pair] += ref.sign * force
-        return normal, total, active
+        self.min_normal_force = min(self.min_normal_force, float(np.min(normal, initial=0.0)))
+        return ContactForces(normal, total, active)
 
     @property
     def count(self) -> int:
         """Samples stored so far."""
         return self.recorder.count
 
-    def store(self, t: float, state, with_contacts: bool = True) -> None:
-        """Store the current state as the next sample, with the contact forces and the solver
-        statistics since the previous sample (``with_contacts``; off for the initial state)."""
-        position, quaternion, _, velocity, omega = state
-        contacts = residual = None
+    def sample_residual(self) -> float | None:
+        """Exudyn's Newton iterations since the previous sample and whether every
+        discontinuous iteration since then succeeded, added to the recorder; the solver's
+        residual of the recorded step."""
         solver = self._solver
-        if with_contacts:
-            contacts = self.contact_forces()
-            self.min_normal_force = min(self.min_normal_force, float(np.min(contacts[0],
-                                                                            initial=0.0)))
-            if solver is not None:
-                count = int(solver.it.newtonStepsCount)
-                self.recorder.accumulate(count - self._last_newton,
-                                         self._discontinuous_failures == 0)
-                self._last_newton = count
-                self._discontinuous_failures = 0
-                residual = float(solver.conv.residual)
-        self.recorder.store(t, position, quaternion, velocity, omega, contacts, residual)
+        if solver is None:
+            return None
+        count = int(solver.it.newtonStepsCount)
+        self.recorder.accumulate(count - self._last_newton, self._discontinuous_failures == 0)
+        self._last_newton = count
+        self._discontinuous_failures = 0
+        return float(solver.conv.residual)
 
     # ------------------------------------------------------------------ user functions
     def _pre_step(self, mbs, t: float) -> bool:
@@ -253,12 +255,12 @@ class Runner:
         explicit_laws = laws is not None and self.config.law_loads == "explicit"
         if self.idle is None and not explicit_laws:
             return True
-        state = self.state()  # read once for both uses below
+        state = self.read_state()  # read once for both uses below
         if self.idle is not None:
             self._switch_idle_connectors(mbs, t, state)
         if not explicit_laws:
             return True
-        position, _, rotation, _, _ = state
+        position, rotation = state.positions, state.rotations
         com = position + np.einsum("bij,bj->bi", rotation, self.built.bodies.com)
         wrench = laws.wrenches(t, com, rotation)
         for b, force, torque in self.built.law_loads:
@@ -268,8 +270,9 @@ class Runner:
 
     def _switch_idle_connectors(self, mbs, t: float, state) -> None:
         """Switch the connectors that cannot touch within the margin off and the others on
-        for the coming step (:mod:`.idle_connectors`); ``state`` as :meth:`state`."""
-        position, _, rotation, velocity, omega = state
+        for the coming step (:mod:`.idle_connectors`); ``state`` as :meth:`read_state`."""
+        position, rotation = state.positions, state.rotations
+        velocity, omega = state.velocities, state.angular_velocities
         idle = self.idle
         margin = idle.margin(velocity, omega, self._idle_acceleration, self.dt)
         for index in idle.update(position, rotation, margin, t):
@@ -303,6 +306,7 @@ class Runner:
         if t <= self._last_time:  # the call of SolveSteps at the start of each nominal step
             return True
         self._last_time = t
+        self.time = t
         tick = time.perf_counter()
         self.solver_steps += 1
         solver = self._solver
@@ -319,26 +323,26 @@ class Runner:
             self.built.law_forces.remember(self.state()[2])
         recording = (self.count < len(self.record_times)
                      and t >= self.record_times[self.count] - 1e-6 * self.dt)
-        problem = self.monitor.after_step(
-            self.solver_steps, t, self.state, self.energy, lambda state: self.store(t, state),
-            recording=recording, checking=self.monitor.guard.due(self.solver_steps),
-            problem=problem)
-        self.record_seconds += time.perf_counter() - tick
+        problem = self.after_step(self.solver_steps, recording=recording,
+                                  checking=self.monitor.guard.due(self.solver_steps),
+                                  problem=problem)
+        self.bookkeeping_seconds += time.perf_counter() - tick
         if problem is not None:
             self.problem = problem
             return False
         return True
 
-    # ------------------------------------------------------------------ loop
-    def run(self) -> tuple[RunStatus, str]:
-        exu = load_exudyn()
-        mbs = self.built.mbs
+    # ------------------------------------------------------------------ steps
+    def prepare(self) -> None:
+        """The solver's settings, with Newton's absolute tolerance from the force scale of the
+        initial state where asked, and the idle connectors' acceleration bound."""
         closed_loop = "closed_loop" in self.scene.features
         s = simulation_settings(self.config, self.dt, self.steps, closed_loop)
+        self._simulation = s
         if closed_loop and self.config.closed_loop_full_pivot:
             self.monitor.guard.notes.append("closed loop: EigenDense full-pivot LU with "
-                                    "ignoreSingularJacobian (redundant constraints)")
-        state = self.state()
+                                            "ignoreSingularJacobian (redundant constraints)")
+        state = self.read_state()
         if self.config.newton_force_tolerance is not None:
             self.force_scale_value = self.force_scale(state)
             if self.force_scale_value > 0.0:
@@ -351,8 +355,25 @@ class Runner:
             lightest = float(np.min(self.mass[self.movable], initial=np.inf))
             if np.isfinite(lightest) and lightest > 0.0:
                 self._idle_acceleration = self.force_scale(state) / lightest
-        self.monitor.guard.start(*self.energy(state))
-        self.store(0.0, state, with_contacts=False)
+
+    @contextlib.contextmanager
+    def session(self):
+        """Exudyn's console output off and ``sys.stdout`` captured (kept for the metadata)."""
+        exu = load_exudyn()
+        previous = exu.config.printToConsole
+        exu.config.printToConsole = False
+        buffer = io.StringIO()
+        try:
+            with contextlib.redirect_stdout(buffer):
+                yield
+        finally:
+            exu.config.printToConsole = previous
+            self.captured_stdout = buffer.getvalue()
+
+    def start(self) -> None:
+        """The user functions installed, the solver initialised."""
+        exu = load_exudyn()
+        mbs = self.built.mbs
         mbs.SetPostStepUserFunction(self._post_step)
         if self.built.law_forces is not None and self.config.law_loads == "implicit":
             self._install_implicit_laws()
@@ -362,56 +383,55 @@ class Runner:
             mbs.SetPreStepUserFunction(self._pre_step)
         solver = exu.MainSolverImplicitSecondOrder()
         self._solver = solver
-        previous = exu.config.printToConsole
-        exu.config.printToConsole = False
-        buffer = io.StringIO()
-        status, message = RunStatus.OK, ""
-        tick = time.perf_counter()
-        try:
-            with contextlib.redirect_stdout(buffer):
-                if not solver.InitializeSolver(mbs, s):
-                    raise exu.SolverError("InitializeSolver failed: "
-                                          + solver.GetErrorString())
-                self._last_newton = int(solver.it.newtonStepsCount)
-                if self.config.step_loop == "horizon":
-                    success = solver.SolveSteps(mbs, s)
-                else:
-                    success = True
-                    for step in range(1, self.steps + 1):
-                        solver.it.endTime = step * self.dt
-                        self._call_start = True
-                        success = solver.SolveSteps(mbs, s)
-                        if not success or self.problem is not None:
-                            break
-                solver.FinalizeSolver(mbs, s)
-            if self.problem is not None:
-                status, message = RunStatus.DIVERGED, self.problem
-            elif not success:
-                self._read_failure(solver, s)
-                status = RunStatus.DIVERGED
-                message = (f"Exudyn solver failed at t = {mbs.systemData.GetTime():.6g}: "
-                           f"{self.error_string}")
-        except exu.ExudynError as error:  # SolverError and the other Exudyn errors
-            self._read_failure(solver, s)
+        if not solver.InitializeSolver(mbs, self._simulation):
+            raise exu.SolverError("InitializeSolver failed: " + solver.GetErrorString())
+        self._last_newton = int(solver.it.newtonStepsCount)
+
+    def advance(self, step: int) -> StepFailure | None:
+        """``SolveSteps`` to the end of nominal step ``step`` ('grid'), or over the whole run
+        at the first step ('horizon'); the stop a callback asked for, or the solver's
+        failure, with the reason read from its flags."""
+        mbs, solver, s = self.built.mbs, self._solver, self._simulation
+        if self.config.step_loop == "horizon":
+            if step > 1:
+                return None
+            success = solver.SolveSteps(mbs, s)
+        else:
+            solver.it.endTime = step * self.dt
+            self._call_start = True
+            success = solver.SolveSteps(mbs, s)
+        if self.problem is None and success:
+            return None
+        self.finish()
+        self.time = mbs.systemData.GetTime()
+        if self.problem is not None:
+            return StepFailure(RunStatus.DIVERGED, self.problem, keep_state=True)
+        self._read_failure(solver, s)
+        return StepFailure(RunStatus.DIVERGED, f"Exudyn solver failed at t = "
+                           f"{mbs.systemData.GetTime():.6g}: {self.error_string}",
+                           keep_state=True)
+
+    def finish(self) -> None:
+        if not self._finalized:
+            self._finalized = True
+            self._solver.FinalizeSolver(self.built.mbs, self._simulation)
+
+    def failure_of(self, error: Exception) -> StepFailure | None:
+        """An Exudyn error (a SolverError: diverged; another: crashed) or an exception of a
+        Python user function or of the adapter (crashed), with the solver's flags read."""
+        exu = load_exudyn()
+        mbs = self.built.mbs
+        if isinstance(error, exu.ExudynError):  # SolverError and the other Exudyn errors
+            if self._solver is not None:
+                self._read_failure(self._solver, self._simulation)
             status = RunStatus.DIVERGED if isinstance(error, exu.SolverError) \
                 else RunStatus.CRASHED
             message = (f"Exudyn {type(error).__name__} at t = {mbs.systemData.GetTime():.6g}: "
                        f"{error} ({self.error_string})")
-        except Exception as error:  # a Python user function or the adapter itself
-            status = RunStatus.CRASHED
-            message = f"{type(error).__name__}: {error}"
-        finally:
-            exu.config.printToConsole = previous
-            self.captured_stdout = buffer.getvalue()
-        self.monitor.stepping_seconds = time.perf_counter() - tick - self.record_seconds
-        if status is not RunStatus.OK:
-            # keep the state where it stopped as the last sample
-            recorder = self.recorder
-            if not recorder.is_full and recorder.times[recorder.count - 1] < \
-                    mbs.systemData.GetTime():
-                self.store(mbs.systemData.GetTime(), self.state())
-            logger.info("%s: stopped: %s", self.scene.name, message)
-        return status, message
+        else:
+            status, message = RunStatus.CRASHED, f"{type(error).__name__}: {error}"
+        self.time = mbs.systemData.GetTime()
+        return StepFailure(status, message, keep_state=True)
 
     def solver_statistics(self) -> dict:
         """Exudyn's counters and timers of the run [s, wall]: Newton iterations, Jacobians,

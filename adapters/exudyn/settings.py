@@ -26,10 +26,10 @@ units by the builder; ratios and counts are dimensionless.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
 
+from clearbench.adapters.engine_settings import GUARD_OPTIONS, EngineSettings
 from clearbench.adapters.options import OptionTable, boolean, choice, integer, number
 
 #: Named presets; each is a separate engine variant ``exudyn[<preset>]`` in results.
@@ -77,7 +77,7 @@ CULLING_CHOICES = ("auto", "on", "off")
 
 
 @dataclass(frozen=True)
-class ExudynSettings:
+class ExudynSettings(EngineSettings):
     """Every option of an Exudyn run.
 
     Attributes
@@ -197,11 +197,8 @@ class ExudynSettings:
         every Newton residual through Python load user functions (implicit).
     internal_units : {'scene', 'SI'}
         Units of the Exudyn model: the scene's own or SI.
-    energy_gain_tolerance : float
-        Energy gain beyond this fraction of the energy scale stops the run as diverged on
-        scenes whose energy may not grow.
-    guard_interval : int
-        Steps between energy checks.
+    energy_gain_tolerance, guard_interval
+        The shared energy guard (:class:`~clearbench.adapters.engine_settings.EngineSettings`).
     """
 
     solver: str = "GeneralizedAlpha"
@@ -243,15 +240,7 @@ class ExudynSettings:
     disc_segments: int = 16
     law_loads: str = "explicit"
     internal_units: str = "scene"
-    energy_gain_tolerance: float = 0.1
-    guard_interval: int = 10
 
-    def __post_init__(self) -> None:
-        OPTIONS.check_settings(self)
-
-    def as_dict(self) -> dict:
-        """Plain-dict form for trajectory metadata."""
-        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
 
 
 #: Type, range and allowed values of every field of :class:`ExudynSettings`.
@@ -295,9 +284,9 @@ OPTIONS = OptionTable("exudyn", (
     integer("disc_segments", at_least=3),
     choice("law_loads", LAW_LOAD_MODES),
     choice("internal_units", UNIT_CHOICES),
-    number("energy_gain_tolerance", above=0.0),
-    integer("guard_interval", at_least=1),
+    *GUARD_OPTIONS,
 ))
+ExudynSettings.OPTIONS = OPTIONS
 OPTION_NAMES = OPTIONS.names
 
 

@@ -104,6 +104,11 @@ class BuiltModel:
     law_forces: LawForces | None = None  # angle / distance law loads, applied every step
     rebuild_overlap: dict = field(default_factory=dict)  # contact name -> [L] (pair_overlaps)
 
+    @property
+    def time_step(self) -> float:
+        """The model's step [T, internal units]."""
+        return self.model.opt.timestep
+
 
 def _relative_pose(parent_pose, child_pose) -> tuple[np.ndarray, np.ndarray]:
     """Pose of the child frame in the parent frame."""

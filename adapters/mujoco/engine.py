@@ -28,8 +28,6 @@ say energy may only decrease (``energy_non_increasing``, ``energy_conserved``).
 
 from __future__ import annotations
 
-import logging
-
 from clearbench.adapters.base import SteppingEngine
 from clearbench.adapters.mujoco import capabilities
 from clearbench.adapters.mujoco.capabilities import (
@@ -44,11 +42,8 @@ from clearbench.adapters.mujoco.settings import (
     MujocoSettings,
     resolve_settings,
 )
-from clearbench.adapters.trajectory import RunStatus
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.validation import TIME, VELOCITY
-
-logger = logging.getLogger(__name__)
 
 __all__ = ["OPTIONS", "PRESETS", "MujocoEngine", "create"]
 
@@ -78,9 +73,6 @@ class MujocoEngine(SteppingEngine):
                record_every: int) -> Runner:
         return Runner(internal, built, config, steps, record_every)
 
-    def step(self, runner: Runner) -> tuple[RunStatus, str]:
-        return _with_logged_warnings(runner)
-
     def metadata(self, scene: Scene, internal: Scene, config: MujocoSettings, built,
                  runner: Runner) -> dict:
         to_internal = scene.units.factor_to(internal.units, TIME)
@@ -106,20 +98,3 @@ class MujocoEngine(SteppingEngine):
             "max_contacts": runner.max_contacts,
         }
 
-
-def _with_logged_warnings(runner) -> tuple[RunStatus, str]:
-    """Run with MuJoCo's text warnings sent to logging (instead of MUJOCO_LOG.TXT in the
-    working directory) and kept for the metadata; the previous handler is restored."""
-    mujoco = runner.mujoco
-    previous = mujoco.get_mju_user_warning()
-
-    def handler(text: str) -> None:
-        logger.warning("mujoco: %s", text)
-        if len(runner.warnings) < 100:
-            runner.warnings.append(f"mujoco: {text}")
-
-    mujoco.set_mju_user_warning(handler)
-    try:
-        return runner.run()
-    finally:
-        mujoco.set_mju_user_warning(previous)

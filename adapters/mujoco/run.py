@@ -1,23 +1,22 @@
-"""The step loop of a MuJoCo run: drivers, loads, guards, read-out into trajectory samples.
+"""One MuJoCo run as the shared step loop drives it (:mod:`clearbench.adapters.stepping`):
+drivers, loads, guards, read-out into trajectory samples.
 
-Used by :mod:`.engine`; works on a model built by :mod:`.build`, in the model's internal units,
-and records with :class:`~clearbench.adapters.recording.SampleRecorder` (the engine converts the
+Works on a model built by :mod:`.build`, in the model's internal units (the engine converts the
 samples back to the scene's units). Each sample's residual is MuJoCo's own for the recorded
-step; iterations and convergence are accumulated over the steps between samples.
+step; iterations and convergence are accumulated over the steps between samples. A step is
+``mj_step1``, the loads of the step start (:meth:`Runner.apply_loads`), ``mj_step2``.
 """
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
-import time
 
 import numpy as np
 
-from clearbench.adapters.energy_guard import EnergyGuard
 from clearbench.adapters.mujoco.settings import MujocoSettings
-from clearbench.adapters.step_monitor import StepMonitor
-from clearbench.adapters.trajectory import RunStatus
+from clearbench.adapters.stepping import BodyState, ContactForces, SolverStep, StepRunner
 from clearbench.kernels.poses import shifted_velocities
 from clearbench.kernels.time_profiles import evaluate_profile_slope
 from clearbench.scenarios.energy import mechanical_energy
@@ -27,21 +26,20 @@ from clearbench.scenarios.scene import Scene
 logger = logging.getLogger(__name__)
 
 
-class Runner:
-    """The step loop of one run: drivers, loads, guards, and sampling into arrays."""
+class Runner(StepRunner):
+    """Drivers, loads, guards and read-out of one run (see the module docstring)."""
+
+    #: MuJoCo's hinge springs and the explicit torsional springs keep their angles.
+    COUNTS_TORSIONAL_SPRINGS = True
 
     def __init__(self, scene: Scene, built, config: MujocoSettings, steps: int,
                  record_every: int):
         import mujoco  # lazy import of the engine package (the adapter imports without it)
 
+        super().__init__(scene, built, config, steps, record_every)
         self.mujoco = mujoco
-        self.scene = scene
-        self.built = built
-        self.config = config
-        self.steps = steps
         self.model, self.data = built.model, built.data
         model = self.model
-        self.dt = model.opt.timestep
         self.ids = built.body_ids
         self.warnings: list[str] = []
         self.mujoco_warnings: dict[str, int] = {}
@@ -50,8 +48,6 @@ class Runner:
         self._site_ids = [(model.site(f"{s.name}:a").id, model.site(f"{s.name}:b").id)
                           for s in self._springs]
         self._hinge_springs = built.hinge_springs
-        self.monitor = StepMonitor(scene, steps, record_every, EnergyGuard(
-            scene, config.energy_gain_tolerance, config.guard_interval))
         step_times = np.arange(steps + 1) * self.dt
         self._drive = []
         for dof in built.driven:
@@ -67,6 +63,34 @@ class Runner:
                                 armature * dof.sign * acceleration))
 
     # ------------------------------------------------------------------ guards
+    @contextlib.contextmanager
+    def session(self):
+        """MuJoCo's text warnings sent to logging (instead of MUJOCO_LOG.TXT in the working
+        directory) and kept for the metadata; the previous handler restored."""
+        mujoco = self.mujoco
+        previous = mujoco.get_mju_user_warning()
+
+        def handler(text: str) -> None:
+            logger.warning("mujoco: %s", text)
+            if len(self.warnings) < 100:
+                self.warnings.append(f"mujoco: {text}")
+
+        mujoco.set_mju_user_warning(handler)
+        try:
+            yield
+        finally:
+            mujoco.set_mju_user_warning(previous)
+
+    def check(self, step: int) -> str | None:
+        """A fatal MuJoCo warning, or a non-finite qpos or qvel, after step ``step``."""
+        data = self.data
+        self.max_contacts = max(self.max_contacts, int(data.ncon))
+        problem = self._check_warnings()
+        if problem is None and not (np.isfinite(data.qpos).all()
+                                    and np.isfinite(data.qvel).all()):
+            problem = f"non-finite state at step {step} (t = {data.time:.6g})"
+        return problem
+
     def _check_warnings(self) -> str | None:
         counts = self.data.warning.number
         if not counts.any():
@@ -94,12 +118,18 @@ class Runner:
         mj.mj_comPos(self.model, self.data)
         mj.mj_comVel(self.model, self.data)
 
-    def _refreshed_state(self):
-        """:meth:`body_state` after :meth:`refresh_kinematics`."""
+    def prepare(self) -> None:
+        """Kinematics of the initial qpos/qvel."""
+        self.refresh_kinematics()
+        self.time = self.data.time
+
+    def read_state(self) -> BodyState:
+        """:meth:`body_state` after :meth:`refresh_kinematics` (the contact forces of the step
+        are not touched by the refresh)."""
         self.refresh_kinematics()
         return self.body_state()
 
-    def body_state(self):
+    def body_state(self) -> BodyState:
         """Body-frame poses, centre-of-mass velocities (world) and angular velocities (body
         axes) of every scene body: (nb, 3), (nb, 4), (nb, 3), (nb, 3)."""
         d, ids = self.data, self.ids
@@ -108,15 +138,14 @@ class Runner:
         offset = d.xipos[ids] - d.subtree_com[self.model.body_rootid[ids]]
         velocity = shifted_velocities(d.cvel[ids, 3:], omega, offset)
         omega_body = np.einsum("bji,bj->bi", rotation, omega)
-        return d.xpos[ids].copy(), d.xquat[ids].copy(), velocity, omega_body
+        return BodyState(d.xpos[ids].copy(), d.xquat[ids].copy(), velocity, omega_body)
 
-    def energy(self, state=None) -> tuple[float, float]:
-        """(total, kinetic) mechanical energy of the current state, or of ``state`` (the
-        :meth:`body_state` of the current configuration, when already read)
-        (:func:`~clearbench.scenarios.energy.mechanical_energy`: kinetic, gravity, linear and
-        torsional springs; internal units)."""
+    def energy(self, state: BodyState) -> tuple[float, float]:
+        """(total, kinetic) mechanical energy of ``state``, the :meth:`body_state` of the
+        current configuration (:func:`~clearbench.scenarios.energy.mechanical_energy`:
+        kinetic, gravity, linear and torsional springs; internal units)."""
         d, ids = self.data, self.ids
-        _, _, velocity, omega = self.body_state() if state is None else state
+        velocity, omega = state.velocities, state.angular_velocities
         sites = dict(zip((load.name for load in self._springs), self._site_ids, strict=True))
 
         def spring_points(load):
@@ -176,47 +205,31 @@ class Runner:
             d.xfrc_applied[b_id, 3:] += moment
             d.xfrc_applied[a_id, 3:] -= moment
 
-    # ------------------------------------------------------------------ loop
-    def run(self) -> tuple[RunStatus, str]:
-        """Step the run, sampling into the monitor; (status, message) of its end."""
+    # ------------------------------------------------------------------ steps
+    def advance(self, step: int) -> None:
+        """Drivers at their profile's values at the step start, ``mj_step1``, the loads,
+        ``mj_step2``."""
         mj = self.mujoco
         model, data = self.model, self.data
-        monitor = self.monitor
-        self.refresh_kinematics()
-        self.store()
-        monitor.guard.start(*self.energy())
-        iterations_cap = model.opt.iterations
-        for k in range(1, self.steps + 1):
-            tick = time.perf_counter()
-            for dof, position, velocity, force in self._drive:
-                data.qpos[dof.qpos_address] = position[k - 1]
-                data.qvel[dof.dof_address] = velocity[k - 1]
-                data.qfrc_applied[dof.dof_address] = force[k - 1]
-            mj.mj_step1(model, data)
-            self.apply_loads()
-            mj.mj_step2(model, data)
-            monitor.stepping_seconds += time.perf_counter() - tick
-            monitor.steps_taken = k
-            islands = min(max(int(data.nisland), 1), len(data.solver_niter))
-            niter = int(data.solver_niter[:islands].max())
-            monitor.solver_step(k, niter, converged=niter < iterations_cap)
-            self.max_contacts = max(self.max_contacts, int(data.ncon))
-            problem = self._check_warnings()
-            if problem is None and not (np.isfinite(data.qpos).all()
-                                        and np.isfinite(data.qvel).all()):
-                problem = f"non-finite state at step {k} (t = {data.time:.6g})"
-            # Kinematics refreshed before reading the state (mj_step leaves them one step
-            # old); the contact forces, read at storing, are not touched by the refresh.
-            problem = monitor.after_step(
-                k, data.time, self._refreshed_state, self.energy,
-                lambda state: self.store(self.contact_forces(), state), problem=problem)
-            if problem is not None:
-                logger.info("%s: stopped: %s", self.scene.name, problem)
-                return RunStatus.DIVERGED, problem
-        return RunStatus.OK, ""
+        for dof, position, velocity, force in self._drive:
+            data.qpos[dof.qpos_address] = position[step - 1]
+            data.qvel[dof.dof_address] = velocity[step - 1]
+            data.qfrc_applied[dof.dof_address] = force[step - 1]
+        mj.mj_step1(model, data)
+        self.apply_loads()
+        mj.mj_step2(model, data)
+        self.time = data.time
+        return None
+
+    def solver_step(self, step: int) -> SolverStep:
+        """Iterations (largest over islands) of the step; converged below the cap."""
+        data = self.data
+        islands = min(max(int(data.nisland), 1), len(data.solver_niter))
+        niter = int(data.solver_niter[:islands].max())
+        return SolverStep(niter, niter < self.model.opt.iterations)
 
     # ------------------------------------------------------------------ read-out
-    def contact_forces(self) -> tuple[np.ndarray, np.ndarray, int]:
+    def contact_forces(self) -> ContactForces:
         """Per scene pair: normal force sum (npair,) and total force on body B, world
         (npair, 3), from the constraint forces of the step just taken; and active contacts."""
         mj = self.mujoco
@@ -244,9 +257,10 @@ class Runner:
                 else -1.0
             normal[pair] += wrench[0]
             total[pair] += sign * world
-        return normal, total, active
+        return ContactForces(normal, total, active)
 
-    def solver_residual(self) -> float:
+    def sample_residual(self) -> float:
+        """MuJoCo's own residual of the recorded step (the largest over islands)."""
         data = self.data
         islands = min(max(int(data.nisland), 1), len(data.solver_niter))
         worst = 0.0
@@ -257,12 +271,3 @@ class Runner:
                                    - 1]
                 worst = max(worst, float(stat.gradient))
         return worst
-
-    def store(self, forces: tuple | None = None, state=None) -> None:
-        """Record the current state (its :meth:`body_state`, or ``state`` when already read)
-        as the next sample; with ``forces`` (from :meth:`contact_forces`), the step's solver
-        statistics and own residual too."""
-        position, orientation, velocity, omega = self.body_state() if state is None else state
-        residual = self.solver_residual() if forces is not None else None
-        self.monitor.recorder.store(self.data.time, position, orientation, velocity, omega,
-                                    contacts=forces, residual=residual)

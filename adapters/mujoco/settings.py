@@ -16,11 +16,11 @@ formula that waits for the spring to relax). MuJoCo integrates that force explic
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
 
 from clearbench.adapters import primitive_pieces
+from clearbench.adapters.engine_settings import GUARD_OPTIONS, EngineSettings
 from clearbench.adapters.options import OptionTable, boolean, choice, integer, number, numbers
 
 #: MuJoCo's own defaults (mjOption and the default geom solref/solimp of MuJoCo 3/4).
@@ -52,7 +52,7 @@ PRESETS: dict[str, dict] = {
 
 
 @dataclass(frozen=True)
-class MujocoSettings:
+class MujocoSettings(EngineSettings):
     """Every option of a MuJoCo run (lengths in the model's internal units, SI by default).
 
     Attributes
@@ -111,11 +111,8 @@ class MujocoSettings:
     internal_units : {'SI', 'scene'}
         Units of the MuJoCo model: MuJoCo's absolute defaults (solimp width 1 mm, margins,
         minimum masses) assume metres and seconds.
-    energy_gain_tolerance : float
-        Energy above its initial value by more than this fraction of the energy scale stops the
-        run as diverged, on scenes whose energy may only decrease.
-    guard_interval : int
-        Steps between energy checks (also checked at every recorded sample).
+    energy_gain_tolerance, guard_interval
+        The shared energy guard (:class:`~clearbench.adapters.engine_settings.EngineSettings`).
     refsafe : bool
         MuJoCo's own clamp of timeconst to >= 2 dt.
     ccd_tolerance_relative : float or None
@@ -150,19 +147,14 @@ class MujocoSettings:
     closure_spacing: float | None = None
     driver_armature_ratio: float = 1e6
     internal_units: str = "SI"
-    energy_gain_tolerance: float = 0.1
-    guard_interval: int = 10
     refsafe: bool = True
     ccd_tolerance_relative: float | None = None
 
     def __post_init__(self) -> None:
-        OPTIONS.check_settings(self)
+        super().__post_init__()
         for name in ("solref", "equality_solref", "solimp", "equality_solimp"):
             object.__setattr__(self, name, tuple(float(x) for x in getattr(self, name)))
 
-    def as_dict(self) -> dict:
-        """Plain-dict form for trajectory metadata."""
-        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
 
     def contact_timeconst(self, time_step: float) -> float:
         """Timeconst of the base contact solref at ``time_step`` [s]."""
@@ -207,11 +199,11 @@ OPTIONS = OptionTable("mujoco", (
     number("closure_spacing", above=0.0, optional=True),
     number("driver_armature_ratio", above=0.0),
     choice("internal_units", ("SI", "scene")),
-    number("energy_gain_tolerance", above=0.0),
-    integer("guard_interval", at_least=1),
+    *GUARD_OPTIONS,
     boolean("refsafe"),
     number("ccd_tolerance_relative", above=0.0, optional=True),
 ))
+MujocoSettings.OPTIONS = OPTIONS
 OPTION_NAMES = OPTIONS.names
 
 

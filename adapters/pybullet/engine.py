@@ -70,7 +70,7 @@ class PybulletEngine(SteppingEngine):
                record_every: int):
         from clearbench.adapters.pybullet.run import Runner
 
-        return Runner(built, steps, record_every)
+        return Runner(internal, built, config, steps, record_every)
 
     def release(self, built) -> None:
         from clearbench.adapters.pybullet.build import disconnect

@@ -1,8 +1,9 @@
-"""The step loop of a PyBullet run: drivers, loads, guards, read-out into trajectory arrays.
+"""One PyBullet run as the shared step loop drives it (:mod:`clearbench.adapters.stepping`):
+drivers, loads, guards, read-out into trajectory samples.
 
-Works on a world built by :mod:`.build`, in its internal units, and records with
-:class:`~clearbench.adapters.recording.SampleRecorder` (the engine converts the samples back to
-the scene's units).
+Works on a world built by :mod:`.build`, in its internal units (the engine converts the samples
+back to the scene's units). A step is the drivers and loads of the step start
+(:meth:`Runner.apply_loads`) and ``stepSimulation``.
 
 Read-out (docs/engines/pybullet.md): PyBullet reports the INERTIAL frame (centre of mass,
 principal axes) of a base (``getBasePositionAndOrientation``) or link
@@ -21,38 +22,28 @@ step) and, on scenes whose energy may only decrease, an energy gain above
 
 from __future__ import annotations
 
-import logging
-import time
-
 import numpy as np
 
-from clearbench.adapters.energy_guard import EnergyGuard
 from clearbench.adapters.pybullet.frames import from_pb
 from clearbench.adapters.pybullet.library import pb
+from clearbench.adapters.pybullet.settings import PybulletSettings
 from clearbench.adapters.pybullet.world import BuiltWorld
-from clearbench.adapters.step_monitor import StepMonitor
-from clearbench.adapters.trajectory import RunStatus
+from clearbench.adapters.stepping import BodyState, ContactForces, SolverStep, StepRunner
 from clearbench.kernels.quaternion import quat_conjugate, quat_multiply, quat_to_matrix
 from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.energy import mechanical_energy, rigid_spring_points
+from clearbench.scenarios.scene import Scene
 
-logger = logging.getLogger(__name__)
 
-class Runner:
-    """The step loop of one run: drivers, loads, guards, and sampling into arrays."""
+class Runner(StepRunner):
+    """Drivers, loads, guards and read-out of one run (see the module docstring)."""
 
-    def __init__(self, built: BuiltWorld, steps: int, record_every: int):
-        self.built = built
+    def __init__(self, scene: Scene, built: BuiltWorld, config: PybulletSettings, steps: int,
+                 record_every: int):
+        super().__init__(scene, built, config, steps, record_every)
         self.client = built.client
-        self.scene = scene = built.scene
-        self.config = built.settings
-        self.steps = steps
-        self.dt = built.time_step
-        self.monitor = StepMonitor(scene, steps, record_every, EnergyGuard(
-            scene, self.config.energy_gain_tolerance, self.config.guard_interval,
-            counts_torsional_springs=False))
-        self.time = 0.0
         self.max_contacts = 0
+        self._analytics = None
         # Static bodies never move: their poses are the scene's.
         self._static_pose = {i: (np.asarray(b.position, float),
                                  np.asarray(b.orientation, float) / np.linalg.norm(
@@ -103,7 +94,10 @@ class Runner:
                 velocity[i], omega[i] = state[6], state[7]
         return com, quat, velocity, omega
 
-    def body_state(self):
+    def read_state(self) -> BodyState:
+        return self.body_state()
+
+    def body_state(self) -> BodyState:
         """Body-frame positions (nb, 3) and quaternions (nb, 4), centre-of-mass velocities
         (nb, 3, world), angular velocities (nb, 3, BODY axes), centres of mass (nb, 3) and
         body rotations (nb, 3, 3)."""
@@ -127,17 +121,21 @@ class Runner:
             rotation[i] = quat_to_matrix(body_quat[i])
             position[i] = com[i] - rotation[i] @ self._inertial_position[i]
             omega_body[i] = rotation[i].T @ omega[i]
-        return position, body_quat, velocity, omega_body, com, rotation
+        return BodyState(position, body_quat, velocity, omega_body, com, rotation)
 
     # ------------------------------------------------------------------ guards
-    def energy(self, state) -> tuple[float, float]:
-        """(total, kinetic) mechanical energy of ``state`` (:meth:`state`):
+    def energy(self, state: BodyState) -> tuple[float, float]:
+        """(total, kinetic) mechanical energy of ``state`` (:meth:`body_state`):
         :func:`~clearbench.scenarios.energy.mechanical_energy` with linear springs (internal
         units)."""
         position, _, velocity, omega, com, rotation = state
         energy = mechanical_energy(self.scene, com, velocity, omega,
                                    rigid_spring_points(self.scene, position, rotation))
         return float(energy.total), float(energy.kinetic)
+
+    def check(self, step: int) -> str | None:
+        """A joint motor left on, after the first step."""
+        return self.check_motors() if step == 1 else None
 
     def check_motors(self) -> str | None:
         """A free joint whose default motor was left on acts with a non-zero motor torque."""
@@ -152,7 +150,7 @@ class Runner:
                         "PyBullet's default velocity motor brakes every joint")
         return None
 
-    # ------------------------------------------------------------------ loop
+    # ------------------------------------------------------------------ steps
     def apply_loads(self, k: int) -> None:
         """Drivers reset to their profile at the step start; loads applied at the centre of
         mass (WORLD_FRAME: force world axes at a world point; moment world axes)."""
@@ -177,44 +175,28 @@ class Runner:
             pb.applyExternalTorque(handle.pb_body, handle.link, list(wrench[i, 3:]),
                                    pb.WORLD_FRAME, physicsClientId=client)
 
-    def run(self) -> tuple[RunStatus, str]:
-        """Step the run, sampling into the monitor; (status, message) of its end."""
-        monitor = self.monitor
-        state = self.body_state()
-        self.store(state)
-        monitor.guard.start(*self.energy(state))
-        client = self.client
-        for k in range(1, self.steps + 1):
-            tick = time.perf_counter()
-            self.apply_loads(k)
-            analytics = pb.stepSimulation(physicsClientId=client)
-            monitor.stepping_seconds += time.perf_counter() - tick
-            self.time = k * self.dt
-            monitor.steps_taken = k
-            self._solver(analytics, k)
-            problem = monitor.after_step(
-                k, self.time, self.body_state, self.energy,
-                lambda state: self.store(state, self.contact_forces()),
-                problem=self.check_motors() if k == 1 else None)
-            if problem is not None:
-                logger.info("%s: stopped: %s", self.scene.name, problem)
-                return RunStatus.DIVERGED, problem
-        return RunStatus.OK, ""
+    def advance(self, step: int) -> None:
+        """The drivers and loads of the step start, then ``stepSimulation``."""
+        self.apply_loads(step)
+        self._analytics = pb.stepSimulation(physicsClientId=self.client)
+        self.time = step * self.dt
+        return None
 
-    def _solver(self, analytics, k: int) -> None:
+    def solver_step(self, step: int) -> SolverStep | None:
         """Iterations (largest over islands) and remaining residual of the step just taken;
         a step that used every iteration with its residual above the threshold did not
         converge."""
+        analytics = self._analytics
         if not analytics:
-            return
+            return None
         iterations = max(int(island["numIterationsUsed"]) for island in analytics)
         residual = max(float(island["remainingResidual"]) for island in analytics)
         converged = not (iterations >= self.config.num_solver_iterations
                          and residual > self.config.solver_residual_threshold)
-        self.monitor.solver_step(k, iterations, converged, residual)
+        return SolverStep(iterations, converged, residual)
 
     # ------------------------------------------------------------------ read-out
-    def contact_forces(self) -> tuple[np.ndarray, np.ndarray, int]:
+    def contact_forces(self) -> ContactForces:
         """Per scene pair: normal force sum (npair,) and total force on body B, world
         (npair, 3), of the step just taken; and the number of points with a normal force."""
         client = self.client
@@ -236,11 +218,4 @@ class Runner:
                         normal[pair] += point[9]
                         total[pair] -= on_a
         self.max_contacts = max(self.max_contacts, active)
-        return normal, total, active
-
-    def store(self, state, forces: tuple | None = None) -> None:
-        """Record ``state`` (from :meth:`body_state`) as the next sample, with the step's
-        contact ``forces`` (from :meth:`contact_forces`) and solver statistics when given."""
-        position, orientation, velocity, omega, _, _ = state
-        self.monitor.recorder.store(self.time, position, orientation, velocity, omega,
-                                    contacts=forces)
+        return ContactForces(normal, total, active)

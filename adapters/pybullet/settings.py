@@ -39,9 +39,9 @@ not a physical choice but a trap, and the run stops with a guard when one is lef
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 
+from clearbench.adapters.engine_settings import GUARD_OPTIONS, EngineSettings
 from clearbench.adapters.options import OptionTable, boolean, choice, integer, number
 from clearbench.adapters.primitive_pieces import PIECE_OPTIONS, PieceSettings
 
@@ -72,7 +72,7 @@ PRESETS: dict[str, dict] = {
 
 
 @dataclass(frozen=True)
-class PybulletSettings(PieceSettings):
+class PybulletSettings(PieceSettings, EngineSettings):
     """Every option of a PyBullet run (internal units, SI by default).
 
     Attributes
@@ -152,11 +152,8 @@ class PybulletSettings(PieceSettings):
         unit (measured: a 100 um clearance reads 100.8 um in metres; the C-60's 2.6 um gap reads
         15 um in metres and 2.8 um in millimetres), and its default margin 0.001 must
         stay below every box and cylinder size.
-    energy_gain_tolerance : float
-        Energy above its initial value by more than this fraction of the energy scale stops the
-        run as diverged, on scenes whose energy may only decrease.
-    guard_interval : int
-        Steps between energy checks (also checked at every recorded sample).
+    energy_gain_tolerance, guard_interval
+        The shared energy guard (:class:`~clearbench.adapters.engine_settings.EngineSettings`).
     """
 
     num_solver_iterations: int = 50
@@ -185,15 +182,7 @@ class PybulletSettings(PieceSettings):
     closure_spacing: float | None = None
     driver_max_force: float = 1e6
     internal_units: str = "SI"
-    energy_gain_tolerance: float = 0.1
-    guard_interval: int = 10
 
-    def __post_init__(self) -> None:
-        OPTIONS.check_settings(self)
-
-    def as_dict(self) -> dict:
-        """Plain-dict form for trajectory metadata."""
-        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
 
 
 #: Type, range and allowed values of every field of :class:`PybulletSettings` (ERP factors and
@@ -226,9 +215,9 @@ OPTIONS = OptionTable("pybullet", (
     number("closure_spacing", above=0.0, optional=True),
     number("driver_max_force", above=0.0),
     choice("internal_units", ("SI", "scene", "mm-g-ms", "auto")),
-    number("energy_gain_tolerance", above=0.0),
-    integer("guard_interval", at_least=1),
+    *GUARD_OPTIONS,
 ))
+PybulletSettings.OPTIONS = OPTIONS
 OPTION_NAMES = OPTIONS.names
 
 
