@@ -30,3 +30,13 @@ def test_the_package_list_is_derived_from_the_folders():
     derived = setup.packages(root)
     assert len(derived) == len(set(derived)) and set(derived) == expected
     assert {"clearbench.adapters.siconos.worker", "clearbench.ref_solver.compiled"} <= expected
+
+
+def test_the_readme_lists_every_doc_page():
+    """The README's documentation list links every page under docs/ (a page added without its
+    line would be found by no reader of the README)."""
+    root = Path(__file__).resolve().parents[1]
+    readme = (root / "README.md").read_text(encoding="utf-8")
+    missing = [page.relative_to(root).as_posix() for page in sorted((root / "docs").rglob("*.md"))
+               if f"]({page.relative_to(root).as_posix()})" not in readme]
+    assert missing == []
