@@ -66,7 +66,7 @@ def _initial_cells(patches, states: np.ndarray):
 
 
 def minimise(patches, rotation: np.ndarray, translation: np.ndarray, partner, tolerance,
-             floor=None, states=None) -> SearchResult:
+             floor=None, states=None, polish: bool = True) -> SearchResult:
     """Minimise the partner's signed distance over the patches at T configurations.
 
     Parameters
@@ -84,6 +84,9 @@ def minimise(patches, rotation: np.ndarray, translation: np.ndarray, partner, to
         it is dropped (default: -inf, resolve everything).
     states : ndarray of int, optional
         Configurations to search (default all); the others keep best = lower = +inf.
+    polish : bool
+        Refine the witness by a bounded local search (:func:`_polish`); the certified bound
+        does not depend on it.
     """
     count = len(rotation)
     tolerance = np.broadcast_to(np.asarray(tolerance, dtype=np.float64), (count,))
@@ -116,13 +119,23 @@ def minimise(patches, rotation: np.ndarray, translation: np.ndarray, partner, to
             radius = np.hypot(su * huk, sv * hvk)
             bound = f - radius
             split_u = su * huk >= sv * hvk  # the Lipschitz bound: halve the longer side
-            factors = partner.lower_models(mapped, f, gradient, radius)
+            # How far the cell reaches across the partner's z axis (its xy-plane): what the
+            # curved models need (|D_xy|), often far less than the covering radius.
+            across = radius
+            if partner.curved_models:
+                axes = rotation_t[s]  # columns: the partner's axes in the patch's frame
+                reach_x = sum(patch.drop(axes[:, :, 0], uk, vk, huk, hvk))
+                reach_y = sum(patch.drop(axes[:, :, 1], uk, vk, huk, hvk))
+                across = np.minimum(radius, np.hypot(reach_x, reach_y))
+            factors = partner.lower_models(mapped, f, gradient, across)
             if factors:
                 model, loss_u, loss_v = _factor_bounds(factors, patch, rotation_t[s], uk, vk,
-                                                       huk, hvk)
+                                                       huk, hvk, su * huk, sv * hvk)
                 better = model > bound
                 bound = np.where(better, model, bound)
-                split_u = np.where(better, loss_u >= loss_v, split_u)
+                # The metric breaks ties (a loss of 0 on both sides).
+                split_u = np.where(better, loss_u + 1e-3 * su * huk >= loss_v + 1e-3 * sv * hvk,
+                                   split_u)
             values[rows], bounds[rows], points[rows], radii[rows] = f, bound, local, radius
             wide_u[rows] = split_u
         order = np.lexsort((values, state))
@@ -154,20 +167,45 @@ def minimise(patches, rotation: np.ndarray, translation: np.ndarray, partner, to
         v = np.concatenate([v - shift_v, v + shift_v])
         hu = np.concatenate([hu, hu])
         hv = np.concatenate([hv, hv])
-    _polish(patches, rotation, translation, partner, best, witness, at)
+    # Polish where it can matter: every state without a floor, and the states whose minimum
+    # may lie below their floor.
+    if polish:
+        _polish(patches, rotation, translation, partner, best, witness, at,
+                ~np.isfinite(floor) | (lower < floor))
     lower = np.minimum(lower, best)
     return SearchResult(best, witness, lower)
 
 
-def _factor_bounds(factors, patch, to_local, u, v, hu, hv):
+def _factor_bounds(factors, patch, to_local, u, v, hu, hv, metric_u, metric_v):
     """Lower bound (N,) of the partner's signed distance over the cells from its lower models
     (:meth:`~.solids.Solid.lower_models`), and how much of the bound's loss halving the u
-    or the v side would address (N,), (N,)."""
+    or the v side would address (N,), (N,). ``metric_u``, ``metric_v``: the cells' half-sides
+    [L] (a model that fails for a cell this large, curvature inf, loses in proportion)."""
     bounds, losses = [], []
     for models in factors:
         best = np.full(len(u), -np.inf)
         best_u, best_v = np.zeros(len(u)), np.zeros(len(u))
         for value0, n, curvature, w in models:
+            if patch.is_curve:
+                part_u = patch.curve_drop(np.einsum("nij,nj->ni", to_local, n), curvature,
+                                          np.einsum("nij,nj->ni", to_local, w), u, hu)
+                part_v = np.zeros(len(u))
+                model = value0 - part_u
+                better = model > best
+                best = np.where(better, model, best)
+                best_u = np.where(better, part_u, best_u)
+                continue
+            if patch.kind == "planar" and np.any(curvature < 0.0):
+                gain = np.minimum(curvature, 0.0)
+                part_u, part_v = patch.planar_drop(np.einsum("nij,nj->ni", to_local, n), gain,
+                                                   np.einsum("nij,nj->ni", to_local, w), hu, hv)
+                model = value0 - part_u - part_v
+                better = model > best
+                best = np.where(better, model, best)
+                best_u = np.where(better, part_u, best_u)
+                best_v = np.where(better, part_v, best_v)
+                continue
+            curvature = np.maximum(curvature, 0.0)  # a gain is left out on other surfaces
             part_u, part_v = patch.drop(np.einsum("nij,nj->ni", to_local, n), u, v, hu, hv)
             curved = curvature > 0.0
             if curved.any():
@@ -175,9 +213,14 @@ def _factor_bounds(factors, patch, to_local, u, v, hu, hv):
                 extent_u, extent_v = patch.drop(np.einsum("nij,nj->ni", to_local, w), u, v,
                                                 hu, hv)
                 extent = extent_u + extent_v
-                quad = np.where(curved, 0.5 * curvature * extent**2, 0.0)
+                with np.errstate(invalid="ignore"):  # inf curvature: replaced below
+                    quad = np.where(curved, 0.5 * curvature * extent**2, 0.0)
                 share = extent_u / np.where(extent > 0.0, extent, 1.0)
                 part_u, part_v = part_u + quad * share, part_v + quad * (1.0 - share)
+                failed = np.isinf(curvature)
+                wide = metric_u >= metric_v
+                part_u = np.where(failed, np.where(wide, np.inf, 0.0), part_u)
+                part_v = np.where(failed, np.where(wide, 0.0, np.inf), part_v)
             model = value0 - part_u - part_v
             better = model > best
             best = np.where(better, model, best)
@@ -200,15 +243,15 @@ POLISH_ITERATIONS = 12
 POLISH_TRIALS = 8
 
 
-def _polish(patches, rotation, translation, partner, best, witness, at) -> None:
+def _polish(patches, rotation, translation, partner, best, witness, at, wanted) -> None:
     """Bounded local search from each configuration's best cell: steepest descent of the exact
     signed distance along the patch (the partner's gradient projected on the patch's
     tangents), each step the best of :data:`POLISH_TRIALS` lengths halving from twice the
     cell's covering radius, the parameters kept in the patch's domain. It only moves the
     witness to a real point with a smaller value (``best`` and ``witness`` updated in place);
-    the certified lower bound is the search's."""
+    the certified lower bound is the search's. ``wanted`` (T,): the states to polish."""
     for k, patch in enumerate(patches):
-        rows = np.nonzero(np.isfinite(best) & (at[:, 0] == k))[0]
+        rows = np.nonzero(wanted & np.isfinite(best) & (at[:, 0] == k))[0]
         if not len(rows):
             continue
         u0, u1, v0, v1 = patch.domain

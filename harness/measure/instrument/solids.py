@@ -174,6 +174,17 @@ def _flat(model):
     return value, gradient, np.zeros(len(value)), gradient
 
 
+def _inside_cylinder(points: np.ndarray, outer: float, radius: np.ndarray):
+    """Lower model of the signed distance of {rho <= outer} (a superset of a cylinder or a
+    capsule of that radius: value rho - outer, convex) for the balls of ``radius`` (N,)
+    around ``points``: |c + D| >= |c| + c^.D + (w.D)^2 / (2 (|c| + |D|)) in the xy-plane
+    (w = z x c^), a negative curvature -1 / (rho + radius) (a gain)."""
+    value, radial = _round(points, outer)
+    rho = value + outer
+    across = np.stack([-radial[:, 1], radial[:, 0], np.zeros(len(rho))], axis=1)
+    return value, radial, -1.0 / (rho + radius), across
+
+
 def _outside_cylinder(points: np.ndarray, inner: float, radius: np.ndarray):
     """Lower model of the signed distance of {rho >= inner} (value inner - rho) for the balls
     of ``radius`` (N,) around ``points``: in the xy-plane |c + D| <= |c| + c^.D + (w.D)^2 /
@@ -256,10 +267,18 @@ class Solid:
             values.append(self.tube)
         return [float(v) for v in values]
 
+    @property
+    def curved_models(self) -> bool:
+        """True when :meth:`lower_models` has models curved across the z axis (they need how
+        far a cell reaches in the xy-plane)."""
+        return self.kind in ("cylinder", "capsule", "disc", "bore") or self.tube > 0.0
+
     def lower_models(self, points: np.ndarray, value: np.ndarray, gradient: np.ndarray,
                      radius: np.ndarray) -> list[list[tuple]]:
-        """Lower models of the signed distance f around ``points`` (N, 3), for the balls of
-        ``radius`` (N,) [L] around them; ``value``, ``gradient``: f and its gradient there.
+        """Lower models of the signed distance f around ``points`` (N, 3), for the points q
+        with |(q - p)_xy| <= ``radius`` (N,) [L] (the displacement's part in the shape's
+        xy-plane; the models do not depend on z); ``value``, ``gradient``: f and its gradient
+        there.
 
         Returns factors, each a list of models (value0 (N,), n (N, 3) with |n| <= 1,
         curvature (N,) >= 0, w (N, 3) unit) of one factor's signed distance d:
@@ -270,17 +289,35 @@ class Solid:
         factors, f >= F(the factors' lower bounds), F the product combination of
         :func:`_product` (nondecreasing in each factor), so the bound holds.
 
-        A convex solid is one factor, its own tangent plane (curvature 0). A non-convex one
+        A convex solid is its own tangent plane (curvature 0); a product of sets (a box, a
+        slab, a cylinder) has one factor per set, each its own tangent plane, and a round
+        factor (and a capsule) also the inside of its infinite cylinder, which curves up
+        across the radius (curvature -1 / (rho + r), a gain). A non-convex one
         is bounded through a product of sets that contains it (a superset's signed distance is
         never larger; an intersection's is at least each part's): a bore by (rho >= R and,
         with a depth, rho <= R + depth) x (|z| <= half_length), the first model concave
         across the radius (value R - rho, curvature 1 / (rho - r) along w = z x rho^ for a
         ball of radius r off the axis); a ring's tube by (R - t <= rho <= R + t) x
         (|z| <= t). A bare curve has none (the search falls back on the Lipschitz bound)."""
-        if self.convex:
-            return [[(value, gradient, np.zeros(len(value)), gradient)]]
         p = np.asarray(points, dtype=np.float64)
         s = self.shape
+        # Products of sets: one factor per set, each its own tangent (a kink of the product,
+        # a box's edge, costs nothing then); a round factor also curves up across z.
+        if self.kind == "box":
+            return [[_flat(_interval(p, i, s.half_extents[i]))] for i in range(3)]
+        if self.kind == "rectangle":
+            return [[_flat(_interval(p, 0, s.half_extents[0]))],
+                    [_flat(_interval(p, 1, s.half_extents[1]))], [_flat(_below(p, s.depth))]]
+        if self.kind in ("cylinder", "disc"):
+            round_models = [_flat(_round(p, s.radius)), _inside_cylinder(p, s.radius, radius)]
+            along = (_interval(p, 2, s.half_length) if self.kind == "cylinder"
+                     else _below(p, s.depth))
+            return [round_models, [_flat(along)]]
+        if self.convex:
+            models = [(value, gradient, np.zeros(len(value)), gradient)]
+            if self.kind == "capsule":
+                models.append(_inside_cylinder(points, s.radius, radius))
+            return [models]
         if self.kind == "bore":
             radial = [_outside_cylinder(p, s.radius, radius)]
             if s.depth is not None:

@@ -154,6 +154,64 @@ class Patch:
         su, sv = self.speeds(u, v, hu, hv)
         return np.hypot(su * hu, sv * hv)
 
+    def curve_drop(self, n: np.ndarray, curvature: np.ndarray, w: np.ndarray, u, hu
+                   ) -> np.ndarray:
+        """For a curve patch (a circle of radius R): an upper bound (N,) [L] of
+        -(n . D - curvature (w . D)^2 / 2) over each cell, D = p - p_centre, for vectors n, w
+        (N, 3) and curvatures (N,) of either sign (negative: the partner's signed distance
+        curves up, a gain). With s = sin(d), d the angle from the centre (|d| <= hu <= pi/2):
+        D = R s t^ - R (1 - cos d) r^ and s^2 / 2 <= 1 - cos d <= s^2 / (1 + cos hu), so the
+        expression is at least a s + Q s^2 (a = R n.t^), minimised over |s| <= sin(hu)."""
+        radius = self.data["R"]
+        tangent = np.stack([-np.sin(u), np.cos(u), np.zeros(len(u))], axis=1)
+        radial = np.stack([np.cos(u), np.sin(u), np.zeros(len(u))], axis=1)
+        a = radius * np.sum(n * tangent, axis=1)
+        n_radial = np.sum(n * radial, axis=1)
+        half = np.minimum(hu, 0.5 * math.pi)
+        limit, lean = np.sin(half), np.tan(0.5 * half)
+        # -R n.r^ (1 - cos d): a gain where n.r^ < 0, a loss where it is > 0.
+        q = radius * np.where(n_radial < 0.0, -0.5 * n_radial,
+                              -n_radial / (1.0 + np.cos(half)))
+        w_tangent = np.abs(np.sum(w * tangent, axis=1))
+        w_radial = np.abs(np.sum(w * radial, axis=1))
+        # (w . D)^2 between R^2 s^2 (|w.t^| - 2 |w.r^| tan(hu/2))+ ... and R^2 s^2 (|w.t^| +
+        # |w.r^| tan(hu/2))^2.
+        low = np.maximum(0.0, w_tangent**2 - 2.0 * w_tangent * w_radial * lean)
+        high = (w_tangent + w_radial * lean) ** 2
+        q = q + np.where(curvature < 0.0, -0.5 * curvature * radius**2 * low,
+                         -0.5 * np.where(curvature > 0.0, curvature, 0.0) * radius**2 * high)
+        edge = -np.abs(a) * limit + q * limit**2
+        with np.errstate(divide="ignore", invalid="ignore"):
+            vertex = np.where((q > 0.0) & (np.abs(a) <= 2.0 * q * limit), -a * a / (4.0 * q),
+                              edge)
+        return -np.minimum(np.where(q > 0.0, vertex, edge), 0.0)
+
+    def planar_drop(self, n: np.ndarray, curvature: np.ndarray, w: np.ndarray, hu, hv
+                    ) -> tuple[np.ndarray, np.ndarray]:
+        """For a plane patch and a curvature <= 0 (a gain): an upper bound of
+        -(n . D - curvature (w . D)^2 / 2) over each cell, as two parts (u side, v side).
+        D = x e1 + y e2 with |x| <= hu, |y| <= hv; with a = (n.e1, n.e2), b = (w.e1, w.e2)
+        and t = b.(x, y), split a = l b + a_perp: the expression is a_perp.(x, y) + l t +
+        k t^2 / 2 (k = -curvature >= 0), bounded below by the sum of the two terms' minima
+        (|t| <= |b1| hu + |b2| hv)."""
+        d = self.data
+        a1, a2 = n @ d["e1"], n @ d["e2"]
+        b1, b2 = w @ d["e1"], w @ d["e2"]
+        norm2 = b1 * b1 + b2 * b2
+        lam = np.where(norm2 > 0.0, (a1 * b1 + a2 * b2) / np.where(norm2 > 0.0, norm2, 1.0),
+                       0.0)
+        p1, p2 = a1 - lam * b1, a2 - lam * b2
+        k = np.maximum(-curvature, 0.0)
+        reach_u, reach_v = np.abs(b1) * hu, np.abs(b2) * hv
+        reach = reach_u + reach_v
+        edge = -np.abs(lam) * reach + 0.5 * k * reach**2
+        with np.errstate(divide="ignore", invalid="ignore"):
+            vertex = np.where((k > 0.0) & (np.abs(lam) <= k * reach), -lam * lam / (2.0 * k),
+                              edge)
+        along = -np.minimum(np.where(k > 0.0, vertex, edge), 0.0)
+        share = np.where(reach > 0.0, reach_u / np.where(reach > 0.0, reach, 1.0), 0.5)
+        return np.abs(p1) * hu + along * share, np.abs(p2) * hv + along * (1.0 - share)
+
     def drop(self, n: np.ndarray, u, v, hu, hv) -> tuple[np.ndarray, np.ndarray]:
         """Upper bound [L] of -(n . (p - p_centre)) over each cell, for vectors ``n`` (N, 3) of
         length <= 1 in the shape's frame, as two parts (N,), (N,) whose sum is the bound: the
@@ -206,21 +264,30 @@ class Patch:
         raise ValueError(f"unknown patch kind {self.kind!r}")
 
 
-def _count(span: float, size: float, per_size: float, low: int = 2, high: int = 64) -> int:
+#: Initial cells per full turn of an angle (the search halves them where it must).
+CELLS_PER_TURN = 8
+
+
+def _count(span: float, size: float, per_size: float, low: int = 1, high: int = 64) -> int:
     return int(min(high, max(low, math.ceil(per_size * span / size))))
+
+
+def _turns(span: float) -> int:
+    """Initial cells of an angle range ``span`` [rad]."""
+    return max(2, math.ceil(CELLS_PER_TURN * span / TWO_PI))
 
 
 def _planar(origin, e1, e2, u_range, v_range, size: float) -> Patch:
     return Patch("planar", (*u_range, *v_range),
-                 (_count(u_range[1] - u_range[0], size, 2.0),
-                  _count(v_range[1] - v_range[0], size, 2.0)),
+                 (_count(u_range[1] - u_range[0], size, 1.0),
+                  _count(v_range[1] - v_range[0], size, 1.0)),
                  {"origin": np.asarray(origin, float), "e1": np.asarray(e1, float),
                   "e2": np.asarray(e2, float)})
 
 
 def _sphere(centre, radius: float, rotation, polar_end: float) -> Patch:
     return Patch("sphere", (0.0, polar_end, 0.0, TWO_PI),
-                 (max(2, round(8 * polar_end / math.pi)), 16),
+                 (max(2, round(4 * polar_end / math.pi)), CELLS_PER_TURN),
                  {"centre": np.asarray(centre, float), "r": float(radius),
                   "Q": np.asarray(rotation, float)})
 
@@ -228,13 +295,13 @@ def _sphere(centre, radius: float, rotation, polar_end: float) -> Patch:
 def _cylinder(radius: float, angles, z_range, size: float) -> Patch:
     span = angles[1] - angles[0]
     return Patch("cylinder", (*angles, *z_range),
-                 (max(2, math.ceil(16 * span / TWO_PI)),
-                  _count(z_range[1] - z_range[0], size, 2.0)), {"r": float(radius)})
+                 (_turns(span), 1),
+                 {"r": float(radius)})
 
 
 def _polar(z0: float, rho_range, angles) -> Patch:
     span = angles[1] - angles[0]
-    return Patch("polar", (*rho_range, *angles), (2, max(2, math.ceil(16 * span / TWO_PI))),
+    return Patch("polar", (*rho_range, *angles), (1, _turns(span)),
                  {"z0": float(z0)})
 
 
@@ -294,9 +361,9 @@ def boundary_patches(solid, clip=None) -> list[Patch]:
         tube = tube_radius(s)
         if tube <= 0.0:
             return [Patch("curve", (*angles, 0.0, 0.0),
-                          (max(2, math.ceil(32 * span / TWO_PI)), 1), {"R": float(s.radius)})]
+                          (_turns(span), 1), {"R": float(s.radius)})]
         patches = [Patch("torus", (*angles, 0.0, TWO_PI),
-                         (max(2, math.ceil(32 * span / TWO_PI)), 8),
+                         (_turns(span), 4),
                          {"R": float(s.radius), "r": tube})]
         if kind == "arc" and span < TWO_PI:
             for angle, sign in ((angles[0], -1.0), (angles[1], 1.0)):
