@@ -26,9 +26,10 @@ allowance everywhere.
 
 Which states (the cost)
 -----------------------
-Each pair is read at every ``stride``-th recorded state (and the last), then at every state
-within a stride of a state where it found an unseen penetration, so that a flagged interval's
-first and last states are exact. The run-wide check of every run (:mod:`.figures`) takes the
+Each pair is read at every ``stride``-th recorded state (and the last), then every pair at
+every state within a stride of a state where an unseen penetration was found, so that a
+flagged interval's first and last states are exact and a pair flagged only between two
+strided states beside it is found too. The run-wide check of every run (:mod:`.figures`) takes the
 stride that reads about :data:`STATES_PER_PAIR` states per pair: an unseen penetration lasting
 at least a stride of recorded states is found wherever it is; ``clearbench check-geometry``
 reads every state (stride 1) unless told otherwise.
@@ -140,7 +141,7 @@ class GeometryCheck:
         unit, clock = f" {length}" if length else "", f" {time}" if time else ""
         return (f"{UNSEEN_PENETRATION}: {self.names[pair]} at t = {self.times[state]:.6g}{clock}"
                 f": the instrument witnesses {self.instrument.penetration[state, pair]:.3g}"
-                f"{unit}, the kernel's figure is {self.kernel[state, pair]:.3g}{unit} "
+                f"{unit}, the kernel's figure is {self.kernel[state, pair] + 0.0:.3g}{unit} "
                 f"(allowance {self.allowance[state, pair]:.2g}{unit}); unseen at {count} "
                 f"recorded states from t = {first:.6g} to {last:.6g}{clock}"
                 + (f", and in {others} other pair(s)" if others > 0 else ""))
@@ -177,13 +178,14 @@ def check(scene, trajectory, kernel_penetration: np.ndarray | None = None,
     round_off = ROUND_OFF_FRACTION * scene_size(scene)
     reading = run_penetration(scene, trajectory, first)
     result = _result(scene, trajectory, kernel, reading, round_off, stride)
-    flagged = result.unseen > 0.0
+    flagged = (result.unseen > 0.0).any(axis=1)
     if stride > 1 and flagged.any():
-        # Every state within a stride of a flagged one, to find the interval's ends.
-        near = np.zeros_like(flagged)
+        # Every pair at every state within a stride of a flagged one (in any pair), to find
+        # the intervals' ends and what happens beside them.
+        near = np.zeros(count, dtype=bool)
         for shift in range(-stride + 1, stride):
-            near |= np.roll(flagged, shift, axis=0) & _shift_valid(count, shift)[:, None]
-        more = near & ~first
+            near |= np.roll(flagged, shift) & _shift_valid(count, shift)
+        more = near[:, None] & ~first
         if more.any():
             extra = run_penetration(scene, trajectory, more)
             reading = _merged(reading, extra)
