@@ -157,7 +157,7 @@ def progress_line(done: int, total: int, spec: RunSpec, record: RunRecord) -> st
     """``[37/135] reference[default] pendulum dt=1 ms ✓ pass 1.2 s``: the run, its verdict
     and the wall time of its worker's run phase."""
     verdict = verdict_text(run_verdict(record.status, record.expectations_passed,
-                                       json.loads(record.metrics or "{}")))
+                                       json.loads(getattr(record, "metrics", "") or "{}")))
     step = format_quantity(spec.time_step * TIME_UNITS[spec.scene.units.time], "s")
     return (f"[{done}/{total}] {spec.engine.label} {spec.scene.name} dt={step} {verdict} "
             f"{format_value(record.worker_seconds, 's')}")
