@@ -26,7 +26,8 @@ allowance everywhere.
 
 Which states (the cost)
 -----------------------
-Each pair is read at every ``stride``-th recorded state (and the last), then every pair at
+Each pair is read at every ``stride``-th recorded state (and the last, and the state where
+the kernel's figure of that pair is largest, so that the two maxima compare), then every pair at
 every state within a stride of a state where an unseen penetration was found, so that a
 flagged interval's first and last states are exact and a pair flagged only between two
 strided states beside it is found too. The run-wide check of every run (:mod:`.figures`) takes the
@@ -175,6 +176,9 @@ def check(scene, trajectory, kernel_penetration: np.ndarray | None = None,
     first = np.zeros((count, pairs), dtype=bool)
     first[::stride] = True
     first[-1:] = True
+    # And each pair's deepest state by the kernel's figure, so that the two maxima compare.
+    deepest = np.argmax(kernel, axis=0) if count else np.zeros(0, dtype=int)
+    first[deepest, np.arange(pairs)] = True
     round_off = ROUND_OFF_FRACTION * scene_size(scene)
     reading = run_penetration(scene, trajectory, first)
     result = _result(scene, trajectory, kernel, reading, round_off, stride)

@@ -124,8 +124,8 @@ def minimise(patches, rotation: np.ndarray, translation: np.ndarray, partner, to
             across = radius
             if partner.curved_models:
                 axes = rotation_t[s]  # columns: the partner's axes in the patch's frame
-                reach_x = sum(patch.drop(axes[:, :, 0], uk, vk, huk, hvk))
-                reach_y = sum(patch.drop(axes[:, :, 1], uk, vk, huk, hvk))
+                reach_x = sum(patch.extent(axes[:, :, 0], uk, vk, huk, hvk))
+                reach_y = sum(patch.extent(axes[:, :, 1], uk, vk, huk, hvk))
                 across = np.minimum(radius, np.hypot(reach_x, reach_y))
             factors = partner.lower_models(mapped, f, gradient, across)
             if factors:
@@ -133,9 +133,9 @@ def minimise(patches, rotation: np.ndarray, translation: np.ndarray, partner, to
                                                        huk, hvk, su * huk, sv * hvk)
                 better = model > bound
                 bound = np.where(better, model, bound)
-                # The metric breaks ties (a loss of 0 on both sides).
-                split_u = np.where(better, loss_u + 1e-3 * su * huk >= loss_v + 1e-3 * sv * hvk,
-                                   split_u)
+                # The metric decides where neither side loses anything.
+                by_loss = np.where(loss_u + loss_v > 0.0, loss_u >= loss_v, split_u)
+                split_u = np.where(better, by_loss, split_u)
             values[rows], bounds[rows], points[rows], radii[rows] = f, bound, local, radius
             wide_u[rows] = split_u
         order = np.lexsort((values, state))
@@ -210,8 +210,8 @@ def _factor_bounds(factors, patch, to_local, u, v, hu, hv, metric_u, metric_v):
             curved = curvature > 0.0
             if curved.any():
                 # (w . (q - p))^2 <= extent^2, extent = the drop of w over the cell.
-                extent_u, extent_v = patch.drop(np.einsum("nij,nj->ni", to_local, w), u, v,
-                                                hu, hv)
+                extent_u, extent_v = patch.extent(np.einsum("nij,nj->ni", to_local, w), u, v,
+                                                  hu, hv)
                 extent = extent_u + extent_v
                 with np.errstate(invalid="ignore"):  # inf curvature: replaced below
                     quad = np.where(curved, 0.5 * curvature * extent**2, 0.0)

@@ -212,6 +212,14 @@ class Patch:
         share = np.where(reach > 0.0, reach_u / np.where(reach > 0.0, reach, 1.0), 0.5)
         return np.abs(p1) * hu + along * share, np.abs(p2) * hv + along * (1.0 - share)
 
+    def extent(self, w: np.ndarray, u, v, hu, hv) -> tuple[np.ndarray, np.ndarray]:
+        """Upper bound of |w . (p - p_centre)| over each cell as (u part, v part): the larger
+        of the drops of w and of -w."""
+        plus_u, plus_v = self.drop(w, u, v, hu, hv)
+        minus_u, minus_v = self.drop(-w, u, v, hu, hv)
+        larger = plus_u + plus_v >= minus_u + minus_v
+        return np.where(larger, plus_u, minus_u), np.where(larger, plus_v, minus_v)
+
     def drop(self, n: np.ndarray, u, v, hu, hv) -> tuple[np.ndarray, np.ndarray]:
         """Upper bound [L] of -(n . (p - p_centre)) over each cell, for vectors ``n`` (N, 3) of
         length <= 1 in the shape's frame, as two parts (N,), (N,) whose sum is the bound: the
@@ -238,8 +246,9 @@ class Patch:
             tangent = np.stack([-np.sin(u), np.cos(u), np.zeros(len(u))], axis=1)
             radial = np.stack([np.cos(u), np.sin(u), np.zeros(len(u))], axis=1)
             n_radial = np.sum(n * radial, axis=1)
+            # -R (1 - cos d) n.r^ is a loss only where n.r^ > 0 (a gain where it is < 0).
             part_u = (np.abs(np.sum(n * tangent, axis=1)) * core * hu
-                      + np.abs(n_radial) * core * 0.5 * hu * hu)
+                      + np.maximum(n_radial, 0.0) * core * 0.5 * hu * hu)
             if self.kind == "cylinder":
                 return part_u, np.abs(n[:, 2]) * hv
             if self.kind == "curve":
@@ -251,7 +260,8 @@ class Patch:
             across = np.sqrt(np.maximum(0.0, np.sum(n * n, axis=1) - along**2))
             turn_u, turn_v = np.abs(np.cos(v)) * hu, hv
             alpha = turn_u + turn_v
-            tube = d["r"] * (across * alpha + np.abs(along) * 0.5 * alpha**2)
+            # r n.(m - m_c): m . (m - m_c) <= 0, a loss only where n.m_c > 0.
+            tube = d["r"] * (across * alpha + np.maximum(along, 0.0) * 0.5 * alpha**2)
             share = np.where(alpha > 0.0, turn_u / np.where(alpha > 0.0, alpha, 1.0), 1.0)
             return part_u + tube * share, tube * (1.0 - share)
         if self.kind == "sphere":
@@ -259,7 +269,9 @@ class Patch:
             normal = local @ d["Q"].T
             along = np.sum(n * normal, axis=1)
             across = np.sqrt(np.maximum(0.0, np.sum(n * n, axis=1) - along**2))
-            total = across * radius + np.abs(along) * radius**2 / (2.0 * d["r"])
+            # The cell lies below its tangent plane (by at most radius^2 / 2r): a loss only
+            # where n points out along the normal.
+            total = across * radius + np.maximum(along, 0.0) * radius**2 / (2.0 * d["r"])
             return total * share_u, total * (1.0 - share_u)
         raise ValueError(f"unknown patch kind {self.kind!r}")
 
