@@ -64,5 +64,6 @@ def test_before_the_release_both_figures_agree():
     scene, run, kernel = window(6.0, 6.75)
     result = geometry_check.check(scene, run, kernel, stride=1)
     assert result.unseen_max == 0.0 and result.agrees
-    # Both see no more than round-off (the reference is rigid): 1e-13 mm.
-    assert result.agreement_max < 1e-12
+    # Both see nothing beyond round-off (the reference is rigid: 1e-13 mm); the check's
+    # round-off allowance is 1e-9 of the scene's size.
+    assert result.agreement_max <= result.round_off
