@@ -278,3 +278,30 @@ def test_instrument_shares_no_code_with_the_kernel():
                 stack.append(target)
     reached = [paths[m] for m in FORBIDDEN if m in seen]
     assert not reached, reached
+
+
+def _with_tube(shape, tube: float):
+    """``shape`` with a ``tube_radius`` (the field K1 may add; read with getattr)."""
+    object.__setattr__(shape, "tube_radius", tube)
+    return shape
+
+
+def test_tube_ring_lying_on_a_plane():
+    """A torus (ring radius 0.5, tube 0.05) lying flat, its centre 0.04 above the floor: every
+    point of its lowest circle is 0.01 below the floor (a flat, conformal contact)."""
+    ring = _with_tube(Circle("ring", radius=0.5), 0.05)
+    _both_orders(Plane("floor"), ((0, 0, 0), IDENTITY), ring, ((0.2, -0.1, 0.04), IDENTITY),
+                 -0.01)
+
+
+def test_tube_arc_end_cap_on_a_face():
+    """An arc with a tube (radius 0.5, tube 0.05, angles 0 .. pi/2) lying flat 0.03 above a
+    face: its tube's lowest points are 0.05 below its centre line, 0.02 into the face. Tilted
+    by 0.3 rad about y, the arc's end at angle 0 (0.5, 0, 0) is its lowest point, and its end
+    cap reaches the tube radius below it."""
+    arc = _with_tube(Arc("arc", radius=0.5, start_angle=0.0, end_angle=math.pi / 2), 0.05)
+    face = Rectangle("face", half_extents=(1.0, 1.0), depth=0.3)
+    _both_orders(face, ((0, 0, 0), IDENTITY), arc, ((0.1, 0.1, 0.03), IDENTITY), -0.02)
+    tilt = tuple(Rotation.from_euler("y", 0.3).as_quat(scalar_first=True))
+    end_height = 0.2 - 0.5 * math.sin(0.3)
+    _both_orders(face, ((0, 0, 0), IDENTITY), arc, ((0.1, 0.1, 0.2), tilt), end_height - 0.05)

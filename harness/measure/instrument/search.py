@@ -131,10 +131,23 @@ def minimise(patches, rotation: np.ndarray, translation: np.ndarray, partner, to
             if factors:
                 model, loss_u, loss_v = _factor_bounds(factors, patch, rotation_t[s], uk, vk,
                                                        huk, hvk, su * huk, sv * hvk)
+                for normal, offset in partner.half_spaces():
+                    # The solid lies in {n . q <= c}: its signed distance is >= n . q - c.
+                    n_local = np.einsum("nij,j->ni", rotation_t[s], normal)
+                    part_u, part_v = patch.drop(n_local, uk, vk, huk, hvk)
+                    plane = mapped @ normal - offset - part_u - part_v
+                    wins = plane > model
+                    model = np.where(wins, plane, model)
+                    loss_u = np.where(wins, part_u, loss_u)
+                    loss_v = np.where(wins, part_v, loss_v)
                 better = model > bound
                 bound = np.where(better, model, bound)
-                # The metric decides where neither side loses anything.
-                by_loss = np.where(loss_u + loss_v > 0.0, loss_u >= loss_v, split_u)
+                # Halve the side that loses most where the losses make the bound's slack;
+                # where the model itself is loose (a superset far from the solid), the
+                # metric's longer side: smaller cells are what the Lipschitz bound needs.
+                losses = loss_u + loss_v
+                by_loss = np.where((losses > 0.0) & (2.0 * losses >= f - model),
+                                   loss_u >= loss_v, split_u)
                 split_u = np.where(better, by_loss, split_u)
             values[rows], bounds[rows], points[rows], radii[rows] = f, bound, local, radius
             wide_u[rows] = split_u
