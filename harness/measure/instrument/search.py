@@ -14,9 +14,12 @@ A cell whose lower bound is at least (best witness - tolerance), or at least the
 ``floor`` (the search only needs to know that f stays above it there), is dropped; the others
 are halved along their longer side. On exit every part of the surface is covered by a dropped
 cell, so the minimum lies in [lower, best] with lower = the smallest bound of a dropped cell
->= min(best - tolerance, floor). The cells are capped (:data:`MAX_CELLS` at a level,
-:data:`MAX_LEVELS` halvings); a search stopped there reports the bound it reached, never the
-tolerance it aimed at.
+>= min(best - tolerance, floor). The cells are capped (:data:`CELLS_PER_STATE` per
+configuration searched and :data:`MAX_CELLS` in all at a level, :data:`MAX_LEVELS` halvings);
+a search stopped there reports the bound it reached, never the tolerance it aimed at. That
+happens where a whole curve of the boundary is a minimum no bound can single out, the medial
+surface of a solid (a ball sunk more than half through a slab: every point of a circle on it
+is deepest).
 """
 
 from __future__ import annotations
@@ -27,7 +30,8 @@ import numpy as np
 
 from clearbench.harness.measure.instrument.solids import combine
 
-#: Most cells alive at one level of the search (all configurations together).
+#: Most cells alive at one level of the search, per configuration searched and in all.
+CELLS_PER_STATE = 20_000
 MAX_CELLS = 2_000_000
 #: Most levels of halving.
 MAX_LEVELS = 120
@@ -100,6 +104,7 @@ def minimise(patches, rotation: np.ndarray, translation: np.ndarray, partner, to
     if not len(patches) or not len(states):
         return SearchResult(best, witness, lower)
     state, patch_index, u, v, hu, hv = _initial_cells(patches, states)
+    cap = min(MAX_CELLS, CELLS_PER_STATE * len(states))
     rotation_t = np.swapaxes(rotation, 1, 2)
     for _level in range(MAX_LEVELS):
         values = np.empty(len(state))
@@ -165,7 +170,7 @@ def minimise(patches, rotation: np.ndarray, translation: np.ndarray, partner, to
         keep = ~dropped
         if not keep.any():
             break
-        if _level == MAX_LEVELS - 1 or 2 * np.count_nonzero(keep) > MAX_CELLS:
+        if _level == MAX_LEVELS - 1 or 2 * np.count_nonzero(keep) > cap:
             np.minimum.at(lower, state[keep], bounds[keep])
             break
         state, patch_index, u, v, hu, hv, wide = (state[keep], patch_index[keep], u[keep],
