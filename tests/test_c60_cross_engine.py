@@ -3,6 +3,7 @@ the report's C-60 section rendered from realistic figures, the demo plan, the en
 
 from __future__ import annotations
 
+import html
 import math
 
 import numpy as np
@@ -176,4 +177,4 @@ def test_the_instrument_figure_stands_beside_the_kernels():
     section = C60Section([*RUNS, run], [], {}, {})
     markdown = "\n".join(section_markdown(section, "f.png"))
     assert "0.0685 UNSEEN 0.0685 more than the kernel's at 7.37 ms" in markdown
-    assert reason in section_html(section)  # the verdict's words among the run messages
+    assert html.escape(reason) in section_html(section)  # among the run messages
