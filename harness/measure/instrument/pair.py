@@ -40,7 +40,7 @@ from clearbench.harness.measure.instrument.placement import (
     relative_transforms,
     shape_placements,
 )
-from clearbench.harness.measure.instrument.search import minimise
+from clearbench.harness.measure.instrument.search import CELLS_PER_STATE, minimise
 from clearbench.harness.measure.instrument.solids import Solid
 from clearbench.harness.measure.instrument.surfaces import boundary_patches
 
@@ -153,7 +153,8 @@ def _screen(sampled: Solid, rotation, translation, partner: Solid, states) -> np
 
 
 def pair_gaps(shape_a, poses_a, shape_b, poses_b, resolution: float | None = None,
-              floor=None, states=None, polish: bool = True) -> PairGaps:
+              floor=None, states=None, polish: bool = True,
+              cells_per_state: int = CELLS_PER_STATE) -> PairGaps:
     """The instrument's reading of a pair at T configurations of its two bodies.
 
     Parameters
@@ -172,6 +173,9 @@ def pair_gaps(shape_a, poses_a, shape_b, poses_b, resolution: float | None = Non
     polish : bool
         Refine each witness by a bounded local search (exact to round-off where the minimum
         is smooth); without it the gap is within ``resolution`` of the minimum all the same.
+    cells_per_state : int
+        The search's cap per configuration (:mod:`.search`); a reading stopped there has the
+        larger resolution it reached.
     """
     a, b = Solid(shape_a), Solid(shape_b)
     do_ab, do_ba = _terms(a, b)
@@ -208,7 +212,8 @@ def pair_gaps(shape_a, poses_a, shape_b, poses_b, resolution: float | None = Non
                          searched)
         patches = boundary_patches(solid, clip)
         m, d = relative_transforms(rotation, position, other_rotation, other_position)
-        result = minimise(patches, m, d, other, tolerance, floor, searched, polish)
+        result = minimise(patches, m, d, other, tolerance, floor, searched, polish,
+                          cells_per_state)
         lower[searched] = np.minimum(lower[searched], result.lower[searched])
         better = searched[result.best[searched] < gap[searched]]
         if not len(better):

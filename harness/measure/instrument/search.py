@@ -14,8 +14,9 @@ A cell whose lower bound is at least (best witness - tolerance), or at least the
 ``floor`` (the search only needs to know that f stays above it there), is dropped; the others
 are halved along their longer side. On exit every part of the surface is covered by a dropped
 cell, so the minimum lies in [lower, best] with lower = the smallest bound of a dropped cell
->= min(best - tolerance, floor). The cells are capped (:data:`CELLS_PER_STATE` per
-configuration searched and :data:`MAX_CELLS` in all at a level, :data:`MAX_LEVELS` halvings);
+>= min(best - tolerance, floor). The cells are capped (:data:`CELLS_PER_STATE` evaluated per
+configuration searched, :data:`MAX_CELLS` alive in all at a level, :data:`MAX_LEVELS`
+halvings);
 a search stopped there reports the bound it reached, never the tolerance it aimed at. That
 happens where a whole curve of the boundary is a minimum no bound can single out, the medial
 surface of a solid (a ball sunk more than half through a slab: every point of a circle on it
@@ -30,8 +31,8 @@ import numpy as np
 
 from clearbench.harness.measure.instrument.solids import combine
 
-#: Most cells alive at one level of the search, per configuration searched and in all.
-CELLS_PER_STATE = 20_000
+#: Most cells evaluated per configuration searched, and alive at one level in all.
+CELLS_PER_STATE = 300_000
 MAX_CELLS = 2_000_000
 #: Most levels of halving.
 MAX_LEVELS = 120
@@ -70,7 +71,8 @@ def _initial_cells(patches, states: np.ndarray):
 
 
 def minimise(patches, rotation: np.ndarray, translation: np.ndarray, partner, tolerance,
-             floor=None, states=None, polish: bool = True) -> SearchResult:
+             floor=None, states=None, polish: bool = True,
+             cells_per_state: int = CELLS_PER_STATE) -> SearchResult:
     """Minimise the partner's signed distance over the patches at T configurations.
 
     Parameters
@@ -91,6 +93,9 @@ def minimise(patches, rotation: np.ndarray, translation: np.ndarray, partner, to
     polish : bool
         Refine the witness by a bounded local search (:func:`_polish`); the certified bound
         does not depend on it.
+    cells_per_state : int
+        The budget of cells evaluated per configuration (the search stops there and reports
+        the bound it reached).
     """
     count = len(rotation)
     tolerance = np.broadcast_to(np.asarray(tolerance, dtype=np.float64), (count,))
@@ -104,7 +109,8 @@ def minimise(patches, rotation: np.ndarray, translation: np.ndarray, partner, to
     if not len(patches) or not len(states):
         return SearchResult(best, witness, lower)
     state, patch_index, u, v, hu, hv = _initial_cells(patches, states)
-    cap = min(MAX_CELLS, CELLS_PER_STATE * len(states))
+    cap = min(MAX_CELLS, cells_per_state * len(states))
+    work = np.zeros(count, dtype=np.int64)
     rotation_t = np.swapaxes(rotation, 1, 2)
     for _level in range(MAX_LEVELS):
         values = np.empty(len(state))
@@ -168,6 +174,14 @@ def minimise(patches, rotation: np.ndarray, translation: np.ndarray, partner, to
         dropped = bounds >= threshold
         np.minimum.at(lower, state[dropped], bounds[dropped])
         keep = ~dropped
+        # A configuration whose evaluated cells would pass its budget stops here with the
+        # bound it reached.
+        work += np.bincount(state, minlength=count)
+        alive = np.bincount(state[keep], minlength=count)
+        stopped = keep & (work[state] + 2 * alive[state] > cells_per_state)
+        if stopped.any():
+            np.minimum.at(lower, state[stopped], bounds[stopped])
+            keep &= ~stopped
         if not keep.any():
             break
         if _level == MAX_LEVELS - 1 or 2 * np.count_nonzero(keep) > cap:
