@@ -87,7 +87,7 @@ def minimise(patches, rotation: np.ndarray, translation: np.ndarray, partner, to
         Resolution aimed at [L] (> 0).
     floor : ndarray (T,), optional
         Values the caller needs resolved only below this [L]: a cell whose lower bound is above
-        it is dropped (default: -inf, resolve everything).
+        it is dropped (default: +inf, resolve everything).
     states : ndarray of int, optional
         Configurations to search (default all); the others keep best = lower = +inf.
     polish : bool
