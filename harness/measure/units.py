@@ -22,6 +22,7 @@ from clearbench.harness.measure.quantities import (
     E,
     FigureUnit,
     L,
+    T,
     V,
     dimension_text,
     of,
