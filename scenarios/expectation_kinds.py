@@ -130,6 +130,9 @@ class ExpectationKind:
     energy_may_not_grow : bool
         The expectation says the scene's mechanical energy may not grow (the engines' energy
         guard and the harness's energy verdict read it).
+    energy_conserved : bool
+        The expectation says the energy is conserved: it judges a loss as well as a gain (the
+        harness's implied conservation check then leaves the scene to it).
     body_stays : bool
         The expectation says its body must not move (between ``start_time`` and ``end_time``
         when it has them): the run's stiction figures are measured on it.
@@ -144,6 +147,7 @@ class ExpectationKind:
     relations: tuple[Relation, ...] = ()
     scene_checks: tuple = ()
     energy_may_not_grow: bool = False
+    energy_conserved: bool = False
     body_stays: bool = False
 
     def __post_init__(self) -> None:
@@ -222,6 +226,13 @@ def energy_may_not_grow(kind: str) -> bool:
     """Whether an expectation of ``kind`` says the scene's energy may not grow."""
     declared = EXPECTATION_KINDS.get(kind)
     return declared is not None and declared.energy_may_not_grow
+
+
+def judges_energy_loss(kind: str) -> bool:
+    """Whether an expectation of ``kind`` says the scene's energy is conserved (a loss fails
+    it)."""
+    declared = EXPECTATION_KINDS.get(kind)
+    return declared is not None and declared.energy_conserved
 
 
 def body_stays(kind: str) -> bool:
@@ -389,7 +400,7 @@ ENERGY_NON_INCREASING = declare_kind(ExpectationKind(
 ))
 ENERGY_CONSERVED = declare_kind(ExpectationKind(
     "energy_conserved", "total mechanical energy is conserved", needs_body=False,
-    energy_may_not_grow=True,
+    energy_may_not_grow=True, energy_conserved=True,
 ))
 NO_PENETRATION = declare_kind(ExpectationKind(
     "no_penetration", "no contact gap below zero", needs_body=False,
