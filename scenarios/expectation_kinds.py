@@ -385,6 +385,17 @@ ROCKING_RATIO = declare_kind(ExpectationKind(
         "(b/h < 1.41)"),),
     scene_checks=(gravity_is_the_scenes,),
 ))
+HOOP_OVER_EDGE = declare_kind(ExpectationKind(
+    "hoop_over_edge",
+    "a hoop sliding without friction and spin at v0 toward a straight edge (its lowest point "
+    "edge_distance before it) pivots about the edge, its centre on the circle of radius r, "
+    "leaves it where cos(theta) = (2 + v0^2/(g r))/3, then flies: the centre's path",
+    {"initial_speed": _V0, "radius": Parameter(LENGTH, POSITIVE, meaning="hoop radius"),
+     "gravity": _G,
+     "edge_distance": Parameter(LENGTH, NON_NEGATIVE,
+                                meaning="lowest point to the edge at t = 0, along the motion")},
+    scene_checks=(gravity_is_the_scenes,),
+))
 STICKS = declare_kind(ExpectationKind(
     "sticks",
     "the body must not move between start_time and end_time",
