@@ -247,8 +247,8 @@ def measure(scene: Scene, trajectory: Trajectory, reference: Trajectory | None =
     if math.isfinite(error):
         out.put("error", error)
     verdict = RunStatus.DIVERGED if reasons else RunStatus.OK
-    return Measurement(out.figures, tuple(results), verdict, "; ".join(reasons) or unseen,
-                       source, "; ".join(out.errors))
+    return Measurement(out.figures, tuple(results), verdict,
+                       _broken(trajectory, reasons) or unseen, source, "; ".join(out.errors))
 
 
 def _geometry(scene, trajectory, out: _Collector) -> str:
@@ -270,6 +270,15 @@ def _geometry(scene, trajectory, out: _Collector) -> str:
     return result.message(scene.units.length, scene.units.time)
 
 
+def _broken(trajectory: Trajectory, reasons: list[str]) -> str:
+    """The verdict's reason: what the engine said and what the harness found, when the engine
+    called a run ok that the harness judges broken (empty when it judges it sound)."""
+    if not reasons:
+        return ""
+    return (f"engine status {trajectory.status.value}, harness: diverged "
+            f"({'; '.join(reasons)})")
+
+
 def _drift(scene, trajectory, out: _Collector, reasons: list[str]) -> None:
     out.put("quaternion_norm_error_max", np.max(metrics.quaternion_norm_error(trajectory)))
     contacts = scene.expanded.contacts
@@ -283,8 +292,10 @@ def _drift(scene, trajectory, out: _Collector, reasons: list[str]) -> None:
         out.put("penetration_relative", np.max(relative))
         worst = int(np.argmax(relative))
         if relative[worst] > 1.0:
+            k = int(np.argmax(depth[:, worst] > feature[worst]))
             reasons.append(f"penetration {np.max(depth[:, worst]):.3g} in {contacts[worst].name}"
-                           f" exceeds its smallest feature {feature[worst]:.3g} (tunnelled)")
+                           f" exceeds its smallest feature {feature[worst]:.3g} (tunnelled, "
+                           f"from t = {trajectory.times[k]:.4g})")
         else:
             swept = metrics.swept_penetration(scene, trajectory)
             out.put("penetration_swept_max", np.max(swept))
@@ -302,8 +313,10 @@ def _drift(scene, trajectory, out: _Collector, reasons: list[str]) -> None:
         out.put("clearance_excess_relative", np.max(relative))
         worst = int(np.argmax(relative))
         if relative[worst] > BORE_ESCAPE_FACTOR:
-            reasons.append(f"journal of {motion.names[worst]} left its bore (excess "
-                           f"{relative[worst]:.3g} radial clearances)")
+            k = int(np.argmax(motion.excess[:, worst] > BORE_ESCAPE_FACTOR * radial[worst]))
+            reasons.append(f"journal of {motion.names[worst]} left its bore at t = "
+                           f"{trajectory.times[k]:.4g} (excess {relative[worst]:.3g} radial "
+                           "clearances)")
     if scene.joints:
         violation = metrics.joint_violation(scene, trajectory)
         out.put("joint_distance_max", np.max(violation.distance))
