@@ -186,7 +186,7 @@ class RunRecord:
             expectations_passed=passed, metrics=json.dumps(figures, sort_keys=True),
             expectations=json.dumps(results, sort_keys=True),
             verdict_reason=measured.reason, metrics_error=measured.metrics_error,
-            verdict=run_verdict(status, passed), measure_key=measure_key)
+            verdict=run_verdict(status, passed, figures), measure_key=measure_key)
 
     @classmethod
     def from_row(cls, row: dict) -> RunRecord:

@@ -140,9 +140,9 @@ def measure_phase(request: WorkerRequest, scene: Scene | None,
     status, reason = trajectory.status, ""
     if status is RunStatus.OK:
         bad = first_non_finite(trajectory)
-        if bad is not None:
-            status, reason = RunStatus.DIVERGED, bad
-            trajectory.status, trajectory.message = status, bad
+        if bad is not None:  # the engine said ok: the verdict says both
+            status, reason = RunStatus.DIVERGED, f"engine status ok, harness: diverged ({bad})"
+            trajectory.status, trajectory.message = status, reason
     out = MeasuredMessage(status=status.value, reason=reason)
     try:
         reference = None
