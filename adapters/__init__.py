@@ -12,9 +12,10 @@ Each ``__init__`` also declares the engine's ``HARNESS_DEFAULTS``
 (:mod:`clearbench.adapters.harness_defaults`: its quick regression runs, rigid or compliant,
 numba, C-60 ladders, colour), from which the harness derives its suites, plans and styles.
 
-Adding an engine: a subpackage with those two functions, its ``HARNESS_DEFAULTS`` and an
-:class:`~clearbench.adapters.base.Engine` subclass, and its line in :data:`ENGINES`; the
-engine-contract test then runs it over every library scene.
+Adding an engine: a subpackage with those two functions, its ``HARNESS_DEFAULTS`` and a
+:class:`~clearbench.adapters.base.SteppingEngine` subclass (the one template,
+docs/engines/adding.md), and its line in :data:`ENGINES`; the engine-contract test then runs
+it over every library scene.
 """
 
 from __future__ import annotations
