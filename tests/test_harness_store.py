@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 
 from clearbench.adapters.trajectory import RunStatus, Trajectory
+from clearbench.harness.measure.verdicts import run_verdict
 from clearbench.harness.run.messages import MeasuredMessage, RanMessage
 from clearbench.harness.run.spec import make_run_spec
 from clearbench.harness.run.store import (
@@ -64,6 +65,19 @@ def test_record_fields_and_derived_times(tmp_path):
     assert row["expectations_passed"] == 1
     assert row["hostname"] and row["cpu"] and row["git_revision"]
     assert store.scene(spec.scene.content_hash) == spec.scene
+
+
+def test_the_stored_verdict_is_the_one_every_reader_derives(tmp_path):
+    # An ok run whose expectations passed but whose instrument witnessed an unseen
+    # penetration (any depth > 0) is stored "unseen penetration", as the report and the CLI
+    # derive it from the row's status, expectations and figures (run_verdict).
+    store = ResultsStore(tmp_path)
+    spec = make_run_spec("bouncing-ball-e0.5", "fake", extra_engine_modules=FAKE)
+    store.record(_record(spec, figures={"unseen_penetration": 1e-4, "error": 0.01}))
+    row = store.get(spec.key)
+    assert row["verdict"] == "unseen penetration"
+    assert row["verdict"] == run_verdict(row["status"], row["expectations_passed"],
+                                         json.loads(row["metrics"]))
 
 
 def test_dataframe_expands_metrics(tmp_path):
