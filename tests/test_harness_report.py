@@ -96,11 +96,13 @@ NOT_FINISHED = {"diverged": "diverged", "crashed": "crashed", "timed_out": "time
 
 def _expected_verdicts(store) -> dict:
     """(scene, engine label) -> the verdict the overview must show, from the store alone: the
-    run at the scene's own step; its status, and for a finished run its expectations."""
+    run at the scene's own step; its status, and for a finished run its expectations; and
+    (scene, engine) -> 'not run' for an engine with no run of the scene."""
     frame = store.dataframe()
-    expected = {(scene, label): "not run" for scene in frame["scene_name"].unique()
-                for label in frame["label"].unique()}
+    expected = {(scene, label.partition("[")[0]): "not run"
+                for scene in frame["scene_name"].unique() for label in frame["label"].unique()}
     for (scene_name, label), runs in frame.groupby(["scene_name", "label"]):
+        expected.pop((scene_name, label.partition("[")[0]), None)
         step = store.scene(runs.iloc[-1]["scene_hash"]).time_step
         row = runs.iloc[int(np.argmin(np.abs(np.log(runs["time_step"] / step))))]
         if row["status"] != "ok":
@@ -113,8 +115,12 @@ def _expected_verdicts(store) -> dict:
     return expected
 
 
-MATRIX_CELL = re.compile(r"""<td class=["']verdict["'] data-scene=["']([^"']+)["'] """
-                         r"""data-engine=["']([^"']+)["'] data-verdict=["']([^"']+)["']""")
+MATRIX_CELL = re.compile(r"""<td class=["']verdict[^"']*["'] data-scene=["']([^"']+)["'] """
+                         r"""data-engine=["']([^"']+)["'] data-verdict=["']([^"']+)["']>"""
+                         r"""(.*?)</td>""", re.S)
+#: A preset's line in a cell: its engine label and verdict.
+CELL_LINE = re.compile(r"""<div class=["']line["'][^>]*data-label=["']([^"']+)["'] """
+                       r"""data-verdict=["']([^"']+)["']""")
 
 
 #: A run's row of a per-scene table: engine, step, then the verdict cell (colour, text).
@@ -123,8 +129,16 @@ RUN_ROW = re.compile(r"<tr><td>[^<]+</td><td class='num'>[^<]+</td><td style='ba
 
 
 def _matrix_cells(page: str) -> dict:
-    return {(html.unescape(scene), html.unescape(engine)): html.unescape(verdict)
-            for scene, engine, verdict in MATRIX_CELL.findall(page)}
+    """(scene, engine label) -> verdict of each preset's line, (scene, engine) -> 'not run'
+    of an empty cell."""
+    cells = {}
+    for scene, engine, verdict, body in MATRIX_CELL.findall(page):
+        lines = CELL_LINE.findall(body)
+        if not lines:
+            cells[(html.unescape(scene), html.unescape(engine))] = html.unescape(verdict)
+        for label, line_verdict in lines:
+            cells[(html.unescape(scene), html.unescape(label))] = html.unescape(line_verdict)
+    return cells
 
 
 def test_overview_matrix_shows_the_verdict_of_status_and_expectations(small_store, tmp_path):
@@ -141,6 +155,12 @@ def test_overview_matrix_shows_the_verdict_of_status_and_expectations(small_stor
     summary = paths["markdown"].read_text()
     for verdict in set(expected.values()) - {"not run"}:
         assert f"**{VERDICTS[verdict].symbol} {verdict}**" in summary
+    # A failed run's line shows the failing expectation's value against its limit.
+    frame = small_store.dataframe()
+    failed = frame[frame["expectations_passed"] == 0].iloc[0]
+    detail = next(r["detail"] for r in json.loads(failed["expectations"])
+                  if r["passed"] is False)
+    assert html.escape(detail) in page and re.search(r"[<>]=? ", detail), detail
     # Per scene, every run's verdict column holds its verdict (not its status), with the
     # verdict's colour, in the page and in the summary.
     runs = small_store.dataframe()
@@ -248,8 +268,8 @@ def test_report_has_the_c60_section_when_the_validation_json_exists(small_store,
     summary = paths["markdown"].read_text()
     assert "C-60: the reference engine against the published figures" in page
     # The C-60 tables come first, before the per-scene detail.
-    assert page.index("C-60: the reference") < page.index("<h2 id='scene-")
-    section = page[page.index("C-60: the reference"):page.index("<h2 id='scene-")]
+    assert page.index("<h2 id='c60-paper'>") < page.index("<h3 id='scene-")
+    section = page[page.index("<h2 id='c60-paper'>"):page.index("<h3 id='scene-")]
     assert "-15.3 %" in section and "nan" not in section.lower()
     assert page.count("data:image/png;base64,") >= 1 and "Trip force vs displacement" in page
     assert "| Trip test: peak force | N | 1.500 | 1.870 | 1.770 | -15.3 % |" in summary
