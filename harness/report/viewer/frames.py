@@ -122,27 +122,42 @@ def _pair_shapes(scene: Scene, trajectory: Trajectory) -> list:
     return out
 
 
-def contact_frames(scene: Scene, trajectory: Trajectory, samples: np.ndarray
-                   ) -> list[list[tuple[int, np.ndarray, np.ndarray]]]:
-    """Per frame (recorded sample index in ``samples``), the contacts that carry force:
-    (pair column, point (3,) [L], force on body B (3,) [F]). The point is the middle of the
-    pair's closest candidate (the scene's own geometry, the kernel of
-    :func:`~clearbench.scenarios.geometry.contacts_between`, placements computed for every
-    frame of a pair at once); the force the engine's, or its normal force along that
+@dataclass(frozen=True)
+class DrawnContacts:
+    """The contacts drawn, n of them, ordered by frame then pair: ``frame`` (n,) index into
+    the time grid, ``pair`` (n,) contact column, ``point`` (n, 3) [L], ``force`` (n, 3) on
+    body B [F]."""
+
+    frame: np.ndarray
+    pair: np.ndarray
+    point: np.ndarray
+    force: np.ndarray
+
+
+NO_CONTACTS = DrawnContacts(np.zeros(0, int), np.zeros(0, int), np.zeros((0, 3)),
+                            np.zeros((0, 3)))
+
+
+def contact_frames(scene: Scene, trajectory: Trajectory, samples: np.ndarray) -> DrawnContacts:
+    """In each frame (recorded sample index in ``samples``), the contacts that carry force.
+    The point is the middle of the pair's closest candidate (the scene's own geometry, the
+    kernel of :func:`~clearbench.scenarios.geometry.contacts_between`, placements computed for
+    every frame of a pair at once); the force the engine's, or its normal force along that
     candidate's normal where the engine gives no vector."""
-    frames: list[list] = [[] for _ in samples]
+    none = NO_CONTACTS
     normal = trajectory.contact_normal_force
     if normal.size == 0:
-        return frames
+        return none
     finite = np.where(np.isfinite(normal), normal, 0.0)[samples]          # (F, np)
     largest = float(np.max(np.abs(finite))) if finite.size else 0.0
     if largest <= 0.0:
-        return frames
+        return none
     loaded = finite > FORCE_FRACTION * largest
     gap = np.empty(MAX_CONTACTS_PER_PAIR)
     point_a = np.empty((MAX_CONTACTS_PER_PAIR, 3))
     point_b = np.empty((MAX_CONTACTS_PER_PAIR, 3))
     frame = np.empty((MAX_CONTACTS_PER_PAIR, 3, 3))
+    frames, pairs, points, normals = [], [], [], []
     for column, pair in enumerate(_pair_shapes(scene, trajectory)):
         where = np.nonzero(loaded[:, column])[0]
         if pair is None or not where.size:
@@ -150,26 +165,34 @@ def contact_frames(scene: Scene, trajectory: Trajectory, samples: np.ndarray
         a, shape_a, b, shape_b = pair
         k = samples[where]
         poses = [(trajectory.positions[k, i], trajectory.orientations[k, i]) for i in (a, b)]
-        finite_poses = np.all(np.isfinite(poses[0][0]), axis=1) & np.all(
-            np.isfinite(poses[1][0]), axis=1)
+        usable = (np.all(np.isfinite(poses[0][0]), axis=1)
+                  & np.all(np.isfinite(poses[1][0]), axis=1)).tolist()
         position_a, rotation_a = shape_world_placements(shape_a, *poses[0])
         position_b, rotation_b = shape_world_placements(shape_b, *poses[1])
         code_a, code_b = shape_code(shape_a), shape_code(shape_b)
         params_a, params_b = pack_shape_parameters(shape_a), pack_shape_parameters(shape_b)
-        for j, f in enumerate(where):
-            if not finite_poses[j]:
+        for j, f in enumerate(where.tolist()):
+            if not usable[j]:
                 continue
             count = pair_contacts(code_a, params_a, position_a[j], rotation_a[j], code_b,
                                   params_b, position_b[j], rotation_b[j], gap, point_a,
                                   point_b, frame)
-            if not count:
-                continue
-            best = int(np.argmin(gap[:count]))
-            force = np.asarray(trajectory.contact_force[samples[f], column], dtype=float)
-            if not np.any(force) or not np.all(np.isfinite(force)):
-                force = finite[f, column] * frame[best, 0]
-            frames[f].append((column, 0.5 * (point_a[best] + point_b[best]), force))
-    return frames
+            if count:
+                best = int(np.argmin(gap[:count]))
+                frames.append(f)
+                pairs.append(column)
+                points.append(0.5 * (point_a[best] + point_b[best]))
+                normals.append(frame[best, 0].copy())
+    if not frames:
+        return none
+    frame_index, pair_index = np.array(frames), np.array(pairs)
+    force = np.asarray(trajectory.contact_force[samples[frame_index], pair_index], dtype=float)
+    given = np.any(force != 0, axis=1) & np.all(np.isfinite(force), axis=1)
+    force = np.where(given[:, None], force,
+                     finite[frame_index, pair_index][:, None] * np.array(normals))
+    order = np.lexsort((pair_index, frame_index))
+    return DrawnContacts(frame_index[order], pair_index[order], np.array(points)[order],
+                         force[order])
 
 
 def _encode(arrays: list[np.ndarray]) -> str:
@@ -188,11 +211,10 @@ def encode_run(scene: Scene, run: RecordedRun, grid: np.ndarray, quantiser: Quan
                            axis=-1)                                  # (F, nb, 7) int16
     deltas = poses.copy()
     deltas[1:] = poses[1:] - poses[:-1]                              # wraps like int16 adds
-    per_frame = contact_frames(scene, trajectory, samples) if contacts else [[] for _ in grid]
-    counts = np.array([len(entries) for entries in per_frame], dtype=np.int16)
-    rows = [(column, *quantiser.positions(point)[0], *_force(force, force_max))
-            for entries in per_frame for column, point, force in entries]
-    table = np.asarray(rows, dtype=np.int16).reshape(-1, 7)
+    drawn = contact_frames(scene, trajectory, samples) if contacts else NO_CONTACTS
+    counts = np.bincount(drawn.frame, minlength=len(grid)).astype(np.int16)
+    table = np.column_stack([drawn.pair, quantiser.positions(drawn.point)[0],
+                             _forces(drawn.force, force_max)]).astype(np.int16).reshape(-1, 7)
     end = float(trajectory.times[-1]) if len(trajectory.times) else 0.0
     return {"label": run.label, "status": run.status, "message": run.message,
             "events": {k: (float(v) if math.isfinite(v) else None)
@@ -201,13 +223,13 @@ def encode_run(scene: Scene, run: RecordedRun, grid: np.ndarray, quantiser: Quan
             "data": _encode([deltas, counts, table])}
 
 
-def _force(force: np.ndarray, force_max: float) -> np.ndarray:
-    """A force (3,) [F] as int16 of ``force_max`` / 32767, shortened (same direction) to
-    ``force_max`` when longer."""
-    magnitude = float(np.linalg.norm(force))
-    if magnitude > force_max:
-        force = force * (force_max / magnitude)
-    return np.round(force / force_max * 32767).astype(np.int16)
+def _forces(forces: np.ndarray, force_max: float) -> np.ndarray:
+    """Forces (n, 3) [F] as int16 of ``force_max`` / 32767, each longer than ``force_max``
+    shortened to it (same direction)."""
+    magnitude = np.linalg.norm(forces, axis=1, keepdims=True)
+    scale = np.where(magnitude > force_max, force_max / np.where(magnitude > 0, magnitude, 1.0),
+                     1.0)
+    return np.round(forces * scale / force_max * 32767).astype(np.int16).reshape(-1, 3)
 
 
 #: The arrows' scale is this percentile of the finished runs' normal forces: an impact's
