@@ -233,6 +233,21 @@ def test_work_precision_points_and_figure():
     assert png.startswith(PNG_SIGNATURE)
 
 
+def test_a_run_that_diverged_is_never_on_the_pareto_front():
+    # mujoco[default]'s diverged run on clearance-pendulum: fastest and, up to where it
+    # stopped, most accurate; the front is drawn over the runs that finished only.
+    frame = pd.DataFrame({
+        "scene_name": ["s"] * 4, "campaign": ["sweep"] * 4,
+        "label": ["a[default]", "a[default]", "b[default]", "b[default]"],
+        "time_step": [1e-3, 5e-4, 1e-3, 5e-4], "error": [1e-2, 5e-3, 1e-9, 2e-3],
+        "stepping_seconds_per_simulated_second": [0.1, 0.2, 0.01, 0.5],
+        "status": ["ok", "ok", "diverged", "crashed"], "key": ["k1", "k2", "k3", "k4"],
+    })
+    points = work_precision_points(frame, "s").set_index("key")
+    assert not points.loc["k3", "pareto"] and not points.loc["k4", "pareto"]
+    assert points.loc["k1", "pareto"] and points.loc["k2", "pareto"]
+
+
 def test_time_series_figure_from_a_fake_run(small_store):
     from clearbench.harness.report.figures import time_series_figure
 
@@ -323,3 +338,49 @@ def test_the_page_reads_in_a_browser(wide_store, tmp_path):
     legend = legend[:legend.index("</table>")]
     for word in ("not run", "default", "energy", "pass"):
         assert f">{word}<" in legend or f" {word}<" in legend, word
+
+
+#: Words of the page that are not abbreviations a reader needs explained.
+PLAIN_CAPITALS = {"HTML", "PNG", "CSV", "JSON", "TOML", "CPU", "CPUs", "NaN", "ON", "OFF", "URL",
+                  "BLAS", "SIGSEGV", "II", "III", "IV", "VTK", "CAD", "STEP", "OK"}
+#: What looks like an abbreviation: capitals (and digits) of two or more, a letter and a digit.
+ABBREVIATION = re.compile(r"(?<![\w-])(?:[A-Z][A-Z0-9]+(?:-\d)?|[A-Z]\d|R\^2)(?![\w-])")
+
+
+def test_the_whole_page_is_readable(small_store, tmp_path):
+    """With the committed C-60 validation and campaigns: tables (no raw Markdown in <pre>)
+    with captions, an id on every heading and a table of contents that resolves, figures two
+    per row inside <details>, a glossary entry for every abbreviation, no paragraph twice."""
+    from clearbench.harness.report.glossary import TERMS, _visible_text
+    from clearbench.harness.report.page import C60_VALIDATION, CAMPAIGNS
+
+    paths = write_report(small_store, tmp_path / "out", c60_validation=C60_VALIDATION,
+                         campaigns=CAMPAIGNS)
+    page = paths["html"].read_text()
+    assert "<pre" not in page and "{'" not in _visible_text(page)
+    tables = re.findall(r"<table\b.*?</table>", page, flags=re.S)
+    assert tables and all("<caption>" in t for t in tables)
+    headings = re.findall(r"<h([1-4])( id='[^']+')?>", page)
+    assert all(ident for level, ident in headings if level != "1")
+    ids = set(re.findall(r"\bid='([^']+)'", page))
+    links = re.findall(r"href='#([^']+)'", page)
+    assert links and set(map(html.unescape, links)) <= ids
+    assert "Tolerance campaign" in page and re.search(r"<details><summary>Figures of c60-paper",
+                                                      page)
+    assert re.search(r"<div class='figs'>(<figure>.*?</figure>){2,}", page, flags=re.S)
+    glossary = page[page.index("<h2 id='glossary'>"):]
+    text = _visible_text(page[:page.index("<h2 id='glossary'>")])
+    used = set(ABBREVIATION.findall(text)) - PLAIN_CAPITALS
+    explained = {t for t in TERMS if f">{html.escape(t)}</dt>" in glossary}
+    assert used <= explained | {"C-60"}, sorted(used - explained)
+    for term in ("C4", "J1", "Q2", "FORM", "FC-1"):
+        assert term in explained
+    paragraphs = [p for p in re.findall(r"<p[^>]*>(.*?)</p>", page, flags=re.S) if len(p) > 80]
+    assert len(paragraphs) == len(set(paragraphs)), "a paragraph is repeated"
+    # The conclusions the page shows are those results.json keeps (the README's table).
+    results = json.loads(paths["results"].read_text())
+    conclusions = page[page.index("<h2 id='conclusions'>"):page.index("<h2 id='overview'>")]
+    for row in results["rows"]:
+        for cell in row:
+            assert html.escape(cell) in conclusions, cell
+    assert results["standing"] and html.escape(results["standing"]) in conclusions

@@ -42,10 +42,14 @@ def _cells(line: str) -> list[str]:
     return [part.strip().replace("\\|", "|") for part in parts]
 
 
-def markdown_html(markdown: str, prefix: str) -> tuple[str, list[str]]:
+def markdown_html(markdown: str, prefix: str, seen: dict[str, str] | None = None,
+                  name: str = "") -> tuple[str, list[str]]:
     """(HTML, image file names) of a campaign section's Markdown: ``#`` headings (ids
     ``prefix-...``), tables (captioned by the paragraph just before, else by the heading),
-    ``- `` lists and paragraphs; images are returned, not drawn."""
+    ``- `` lists and paragraphs; images are returned, not drawn. ``seen``: paragraph -> the
+    campaign ``name`` that showed it first (a paragraph another campaign already showed says
+    so instead of repeating it; ``seen`` is updated)."""
+    seen = {} if seen is None else seen
     blocks: list[list[str]] = []
     for line in markdown.splitlines():
         if not line.strip():
@@ -83,15 +87,25 @@ def markdown_html(markdown: str, prefix: str) -> tuple[str, list[str]]:
         elif " ".join(block).rstrip().endswith(":"):
             caption = " ".join(block).rstrip()
         else:
-            parts.append(f"<p>{_inline(' '.join(block))}</p>")
+            text = " ".join(block)
+            if text in seen:
+                first = text.split(":", 1)[0] if ":" in text[:40] else "This paragraph"
+                parts.append(f"<p class='small'>{esc(first)}: as for {esc(seen[text])} "
+                             "above.</p>")
+            else:
+                seen[text] = name
+                parts.append(f"<p>{_inline(text)}</p>")
     if caption:
         parts.append(f"<p>{_inline(caption)}</p>")
     return "".join(parts), images
 
 
-def campaign_html(summary: dict, pngs: dict[str, bytes]) -> str:
-    """One campaign's section: its text and tables as HTML, its figures folded two per row."""
+def campaign_html(summary: dict, pngs: dict[str, bytes], seen: dict[str, str] | None = None
+                  ) -> str:
+    """One campaign's section: its text and tables as HTML, its figures folded two per row.
+    ``seen``: as :func:`markdown_html` (shared by the page's campaigns)."""
     name = summary["definition"]["name"]
-    body, images = markdown_html(render_markdown(summary, list(pngs)), f"campaign-{slug(name)}")
+    body, images = markdown_html(render_markdown(summary, list(pngs)), f"campaign-{slug(name)}",
+                                 seen, name)
     figures = [(pngs[f], figure_caption(name, f)) for f in images if f in pngs]
     return body + figure_grid(figures, f"Figures of {name}")

@@ -61,6 +61,8 @@ TERMS: dict[str, str] = {
     "LSL": "lower specification limit",
     "USL": "upper specification limit",
     "CI": "confidence interval",
+    "CV": "coefficient of variation: standard deviation over mean (of an estimate)",
+    "RMS": "root mean square",
     "sigma": "standard deviation",
     "LARS": "least-angle regression: how a polynomial chaos keeps its terms",
     "chaos": "polynomial chaos expansion: a metamodel of orthogonal polynomials in the inputs",

@@ -135,7 +135,7 @@ def legend_html(words: dict[str, str]) -> str:
 PRESET_WORDS = {
     "default": "preset: the engine's own defaults (the reference: its nonsmooth Moreau-Jean "
                "scheme at its default tolerances)",
-    "tuned": "preset: settings chosen for contact accuracy (docs/engines/ENGINE.md)",
+    "tuned": "preset: settings chosen for contact accuracy (the engine's page in docs/engines/)",
     "mechanism": "preset (Exudyn): settings for the C-60 mechanism (docs/engines/exudyn.md)",
     "projection": "preset (Siconos): the combined projection scheme (docs/engines/siconos.md)",
     "nsn-ac": "preset (Siconos): the Alart-Curnier Newton solver (docs/engines/siconos.md)",
@@ -168,7 +168,7 @@ def words_used(lines: Sequence[CellLine]) -> dict[str, str]:
     used = {}
     for line in lines:
         used[line.preset] = PRESET_WORDS.get(line.preset, "preset: the engine's named "
-                                             "settings (docs/engines/ENGINE.md)")
+                                             "settings (its page in docs/engines/)")
         for word, meaning in FIGURE_WORDS.items():
             if line.figure.startswith(word) or f" {word} " in f" {line.figure} ":
                 used[word] = meaning

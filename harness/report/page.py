@@ -57,6 +57,7 @@ from clearbench.harness.report.overview import (
     matrix_html,
     matrix_markdown,
 )
+from clearbench.harness.report.readme_table import results_document, write_results
 from clearbench.harness.report.viewer.payload import CSS as VIEWER_CSS
 from clearbench.harness.report.viewer.payload import viewer_scripts
 from clearbench.harness.run.store import ResultsStore
@@ -310,7 +311,7 @@ def _runs_table_html(section: SceneSection) -> str:
                         for c in columns)
         passed = run["expectations_passed"]
         mark = "—" if passed is None or (isinstance(passed, float) and math.isnan(passed)) \
-            else ("pass" if int(passed) else "FAIL")
+            else ("all passed" if int(passed) else "one failed")
         rows.append(
             f"<tr><td>{_esc(run['label'] + role)}</td><td class='num'>{run['time_step']:.3g}"
             f"</td>{_run_verdict_td(run)}<td>{mark}</td>{cells}"
@@ -463,6 +464,21 @@ def _c60_markdown(validation: dict, figure_files: dict) -> list[str]:
     return lines + [""]
 
 
+def provenance(data: ReportData) -> str:
+    """Where the report's figures come from: the store, its runs and revisions."""
+    frame = data.frame
+    revisions = ", ".join(sorted(set(frame["git_revision"].str[:12]))) if len(frame) else "-"
+    return (f"{len(frame)} runs of the results store (revision {revisions}, "
+            f"{data.generated[:10]})")
+
+
+def results(data: ReportData) -> dict:
+    """The conclusions as the README's table takes them (:mod:`.readme_table`)."""
+    lines = conclusions(data.engines, data.sections, data.c60_engines)
+    return results_document(HEAD, [c.cells() for c in lines], standing(data.c60_validation),
+                            provenance(data))
+
+
 def _conclusions_html(data: ReportData) -> str:
     lines = conclusions(data.engines, data.sections, data.c60_engines)
     if not lines:
@@ -514,7 +530,8 @@ def render_html(data: ReportData) -> str:
     revisions = ", ".join(sorted(set(frame["git_revision"].str[:12]))) if len(frame) else ""
     counts = frame["status"].value_counts().to_dict() if len(frame) else {}
     summary = ", ".join(f"{v} {k}" for k, v in sorted(counts.items()))
-    details = [s for s in data.sections]
+    details = list(data.sections)
+    shown: dict[str, str] = {}        # campaign paragraphs already on the page
     body = [
         _conclusions_html(data),
         _overview_html(data, stiff=False),
@@ -524,7 +541,7 @@ def render_html(data: ReportData) -> str:
         (heading(2, "Each scene in detail", "scenes") if details else ""),
         *(_section_html(s) for s in details),
         (heading(2, "Tolerance campaigns", "campaigns") if data.campaigns else ""),
-        *(campaign_html(summary, pngs) for summary, pngs in data.campaigns),
+        *(campaign_html(summary, pngs, shown) for summary, pngs in data.campaigns),
         _engines_html(data),
     ]
     text = "".join(body)
@@ -635,9 +652,10 @@ def write_report(store: ResultsStore, out_dir: str | Path,
             name = f"figures/{section.name}-{index}.png"
             (out / name).write_bytes(png)
             figure_files.setdefault(section.name, {})[title] = name
+    write_results(results(data), out / "results.json")
     html_path = out / "report.html"
     md_path = out / "summary.md"
     html_path.write_text(render_html(data), encoding="utf-8")
     md_path.write_text(render_markdown(data, figure_files, c60_figure_files, c60_engines_figure),
                        encoding="utf-8")
-    return {"html": html_path, "markdown": md_path}
+    return {"html": html_path, "markdown": md_path, "results": out / "results.json"}

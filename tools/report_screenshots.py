@@ -1,0 +1,65 @@
+"""Screenshots of the comparison report for the docs, in headless Chromium: the first screen,
+the conclusions, and the C-60 viewer at the reference's strike, release and opening.
+
+    python -m tools.report_screenshots [--report reports/out/report.html] [--out docs/images]
+
+Run it after ``make demo`` (which writes the report); it overwrites ``report-first-screen.png``,
+``report-conclusions.png`` and ``viewer-strike.png``, ``viewer-release.png``,
+``viewer-opening.png`` in ``--out``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from clearbench.harness.report import browser
+
+#: (file, address suffix, window width, window height [CSS px]) of each screenshot.
+SHOTS = (
+    ("report-first-screen.png", "", 1366, 768),
+    ("report-conclusions.png", "#conclusions", 1366, 900),
+    ("viewer-strike.png", "?view-event=strike#c60-viewer", 1366, 900),
+    ("viewer-release.png", "?view-event=release#c60-viewer", 1366, 900),
+    ("viewer-opening.png", "?view-event=opening#c60-viewer", 1366, 900),
+)
+
+
+def take(report: Path, out: Path) -> list[Path]:
+    """Write every screenshot of :data:`SHOTS` of ``report`` into ``out``.
+
+    Raises
+    ------
+    browser.BrowserError
+        Chromium is missing or failed, or the page logged a console message.
+    """
+    if not report.is_file():
+        raise FileNotFoundError(f"--report {report}: no such file (run `make demo` first)")
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name, suffix, width, height in SHOTS:
+        errors = browser.screenshot(report.resolve().as_uri() + suffix, out / name, width,
+                                    height)
+        if errors:
+            raise browser.BrowserError(f"{name}: the page logged {errors}")
+        written.append(out / name)
+    return written
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--report", default="reports/out/report.html", type=Path)
+    parser.add_argument("--out", default="docs/images", type=Path)
+    args = parser.parse_args(argv)
+    try:
+        for path in take(args.report, args.out):
+            print(path)
+    except (FileNotFoundError, browser.BrowserError) as error:
+        print(f"report_screenshots: {error}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
