@@ -109,7 +109,7 @@ def test_c60_section_renders_every_engine_and_the_reasons():
                   "exudyn[tuned]"):
         assert label in page
     assert "diverged at 0.111 ms" in page              # where the Exudyn run stopped
-    assert "SLIPS, 1.64" in page and "holds" in page    # the latch verdicts
+    assert "SLIPS, creep 1.64 mm" in page and "holds" in page    # the latch verdicts
     assert "-0.79 %" in page                           # FC-1 of mujoco[tuned] vs the reference
     assert "7.480 (-1.45 %)" in page                    # opening time vs the reference's
     # worst joint, all folded; 1e-6 mm written in um

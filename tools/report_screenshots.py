@@ -12,18 +12,27 @@ from __future__ import annotations
 
 import argparse
 import sys
+import tempfile
 from pathlib import Path
 
 from clearbench.harness.report import browser
 
-#: (file, address suffix, window width, window height [CSS px]) of each screenshot.
+#: (file, query, the element scrolled to the top (none: the first screen), window width and
+#: height [CSS px]) of each screenshot.
 SHOTS = (
-    ("report-first-screen.png", "", 1366, 768),
-    ("report-conclusions.png", "#conclusions", 1366, 900),
-    ("viewer-strike.png", "?view-event=strike#c60-viewer", 1366, 900),
-    ("viewer-release.png", "?view-event=release#c60-viewer", 1366, 900),
-    ("viewer-opening.png", "?view-event=opening#c60-viewer", 1366, 900),
+    ("report-first-screen.png", "", "", 1366, 768),
+    ("report-conclusions.png", "", "conclusions", 1366, 900),
+    ("viewer-strike.png", "?view-event=strike", "c60-viewer", 1366, 900),
+    ("viewer-release.png", "?view-event=release", "c60-viewer", 1366, 900),
+    ("viewer-opening.png", "?view-event=opening", "c60-viewer", 1366, 900),
 )
+#: Appended to a copy of the page: the page's blocks before the one that holds the element
+#: are hidden, so that the screenshot starts at it (headless Chromium's screenshot does not
+#: follow a scroll).
+SCROLL = ("<script>(() => {{ let e = document.getElementById('{target}');"
+          "while (e && e.parentElement !== document.body) e = e.parentElement;"
+          "for (let p = e && e.previousElementSibling; p; p = p.previousElementSibling)"
+          " p.style.display = 'none'; }})();</script>")
 
 
 def take(report: Path, out: Path) -> list[Path]:
@@ -37,13 +46,22 @@ def take(report: Path, out: Path) -> list[Path]:
     if not report.is_file():
         raise FileNotFoundError(f"--report {report}: no such file (run `make demo` first)")
     out.mkdir(parents=True, exist_ok=True)
+    page = report.read_text(encoding="utf-8")
     written = []
-    for name, suffix, width, height in SHOTS:
-        errors = browser.screenshot(report.resolve().as_uri() + suffix, out / name, width,
-                                    height)
-        if errors:
-            raise browser.BrowserError(f"{name}: the page logged {errors}")
-        written.append(out / name)
+    with tempfile.TemporaryDirectory(prefix="clearbench-shots-") as folder:
+        for name, query, target, width, height in SHOTS:
+            copy = Path(folder) / f"{target or 'top'}.html"
+            if not copy.exists():
+                script = SCROLL.format(target=target) if target else ""
+                # before the page's own scripts: the viewer lays out in the shortened page
+                viewer = "class='cb-viewer'" in page
+                cut = (page.rfind("<script>", 0, page.rfind("<script>")) if viewer
+                       else page.rfind("</body>"))
+                copy.write_text(page[:cut] + script + page[cut:], encoding="utf-8")
+            errors = browser.screenshot(copy.as_uri() + query, out / name, width, height)
+            if errors:
+                raise browser.BrowserError(f"{name}: the page logged {errors}")
+            written.append(out / name)
     return written
 
 

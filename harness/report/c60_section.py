@@ -188,10 +188,11 @@ def _status(run: C60RunFigures) -> str:
 
 
 def latch_text(run: C60RunFigures) -> str:
-    """``holds, 1.2e-09 µm`` / ``SLIPS, 1.64 mm``: the latch's state and the hook's creep."""
+    """``holds, creep 0.0012 µm`` / ``SLIPS, creep 1.64 mm``: the latch's state and the hook's
+    creep."""
     if run.latched is None:
         return "—" if math.isnan(run.latch_creep) else length(run.latch_creep)
-    return f"{'holds' if run.latched else 'SLIPS'}, {length(run.latch_creep)}"
+    return f"{'holds' if run.latched else 'SLIPS'}, creep {length(run.latch_creep)}"
 
 
 def length(value: float, unit: str = "mm") -> str:
@@ -274,14 +275,15 @@ def c60_cell_texts(section: C60Section) -> dict[str, str]:
     for run in section.runs:
         if run.status != "ok":
             continue
+        reference = reference_run(section.runs, run.scene_name, run.horizon)
+        if reference is not None and reference.key == run.key:
+            reference = None     # the yardstick itself: nothing to compare with
         if run.scene_name == ON_SCENE:
-            change = relative(run.fc1, _reference_value(section.runs, ON_SCENE, run.horizon,
-                                                        "fc1"))
+            change = relative(run.fc1, reference.fc1) if reference else math.nan
             versus = "" if math.isnan(change) else f" ({100 * change:+.2g} %)"
             texts[run.key] = f"FC-1 {format_value(run.fc1, 'N')}{versus}, latch " \
                              f"{latch_text(run)}"
         elif run.scene_name == TRIP_SCENE:
-            reference = reference_run(section.runs, TRIP_SCENE, run.horizon)
             texts[run.key] = ", ".join(f"{c.event} {c.text()}"
                                        for c in compare_events(run, reference))
     return texts

@@ -42,14 +42,19 @@ class Conclusion:
 
 
 def _finest(runs, label: str, scene_name: str):
+    """The label's finest finished run of the scene on the comparison's horizon, else its
+    finest run of any status (an unsupported one last)."""
     horizon = c60_motion.comparison_horizon(runs, scene_name)
     mine = [r for r in runs if r.label == label and r.scene_name == scene_name
-            and r.horizon == horizon and r.status != "unsupported"]
+            and r.horizon == horizon]
     finished = [r for r in mine if r.status == "ok"]
-    return min(finished or mine, key=lambda r: r.time_step) if mine else None
+    built = [r for r in mine if r.status != "unsupported"]
+    return min(finished or built or mine, key=lambda r: r.time_step) if mine else None
 
 
 def _status(run) -> str:
+    if run.status == "unsupported":
+        return "unsupported"
     text = run.status
     if math.isfinite(run.simulated_until) and run.simulated_until < run.horizon:
         text += f" at {run.simulated_until:.3g} ms"
@@ -62,6 +67,8 @@ def on_text(section: C60Section | None, label: str) -> str:
     run = _finest(section.runs, label, ON_SCENE) if section else None
     if run is None:
         return "not run"
+    if run.status == "unsupported":
+        return "unsupported"
     if run.status != "ok":
         return f"{_status(run)} (dt {run.time_step:g} ms)"
     reference = reference_run(section.runs, ON_SCENE, run.horizon)
@@ -76,6 +83,8 @@ def trip_text(section: C60Section | None, label: str) -> str:
     run = _finest(section.runs, label, TRIP_SCENE) if section else None
     if run is None:
         return "not run"
+    if run.status == "unsupported":
+        return "unsupported"
     if run.status != "ok":
         return f"{_status(run)} (dt {run.time_step:g} ms)"
     reference = reference_run(section.runs, TRIP_SCENE, run.horizon)
@@ -91,6 +100,9 @@ def budget_text(section: C60Section | None, label: str) -> str:
     if not steps:
         return "not run"
     step = steps[0]
+    runs = [r for r in section.runs if r.label == label and r.scene_name == ON_SCENE]
+    if runs and all(r.status == "unsupported" for r in runs):
+        return "unsupported"
     if step.time_step is None:
         return f"not met: {step.reason}"
     return f"dt {step.time_step:g} ms ({format_value(step.wall_seconds)} s per run)"

@@ -22,7 +22,7 @@ REFERENCE_ENGINE = "reference"
 #: The word of a cell whose engine has no run of the scene.
 NOT_RUN = "not run"
 #: Longest text of a line's figure before it is cut (the whole text is the cell's title).
-FIGURE_CHARS = 90
+FIGURE_CHARS = 120
 
 
 @dataclass(frozen=True)
@@ -56,16 +56,15 @@ def failed_expectations(row: dict) -> list[dict]:
 
 
 def run_figure(row: dict, scene: Scene | None, c60_text: str = "") -> str:
-    """What a cell shows under a run's verdict: the failed expectations' values against their
-    limits, the message of a run that did not finish, ``c60_text`` (the C-60's FC-1 and
-    latch) for a C-60 run, else the scene's headline figure."""
+    """What a cell shows under a run's verdict: the message of a run that did not finish;
+    ``c60_text`` (the C-60's FC-1 against the reference's and the latch, or its trip events)
+    for a C-60 run and the failed expectations' values against their limits; else the scene's
+    headline figure."""
     if row["status"] != "ok":
         return (row.get("message") or "").split("\n", 1)[0]
-    failed = failed_expectations(row)
-    if failed:
-        return "; ".join(r.get("detail") or r.get("name", "") for r in failed)
-    if c60_text:
-        return c60_text
+    failed = "; ".join(r.get("detail") or r.get("name", "") for r in failed_expectations(row))
+    if c60_text or failed:
+        return "; ".join(filter(None, [c60_text, failed]))
     figures = json.loads(row.get("metrics") or "{}")
     name, value = headline(scene, figures) if scene is not None else ("", math.nan)
     if not name:

@@ -238,7 +238,7 @@ th{background:#f3f3f3}td.num{text-align:right;font-variant-numeric:tabular-nums}
 table.matrix{width:100%;table-layout:fixed;font-size:.8em}table.matrix th.scene{width:12%}
 table.matrix .line{padding:.15em .3em;margin:1px 0;border-radius:2px}
 td.notrun{color:#777;background:#fafafa}
-table.conclusions{font-size:.82em}.toc{columns:2;font-size:.9em}.toc ul{margin:0}
+table.conclusions{font-size:.82em}.toc{font-size:.9em;margin:.5em 0 1em}
 dl.glossary{display:grid;grid-template-columns:max-content 1fr;gap:.2em 1em;font-size:.9em}
 dl.glossary dt{font-weight:600}dl.glossary dd{margin:0}
 details>summary{cursor:pointer}
@@ -501,25 +501,20 @@ HEADING = re.compile(r"<h([23]) id='([^']+)'>(.*?)</h\1>")
 
 
 def table_of_contents(body: str) -> str:
-    """The page's h2 and h3 headings as nested links (each heading has an id)."""
-    items, open_sub = [], False
+    """The page's h2 headings as links, each followed by its h3 headings' links in
+    parentheses: a compact paragraph (every heading has an id)."""
+    entries: list[tuple[str, list[str]]] = []
     for level, ident, text in HEADING.findall(body):
         link = f"<a href='#{ident}'>{text}</a>"
-        if level == "2":
-            if open_sub:
-                items.append("</ul></li>")
-                open_sub = False
-            elif items:
-                items.append("</li>")
-            items.append(f"<li>{link}")
+        if level == "2" or not entries:
+            entries.append((link, []))
         else:
-            if not open_sub:
-                items.append("<ul>")
-                open_sub = True
-            items.append(f"<li>{link}</li>")
-    items.append("</ul></li>" if open_sub else "</li>" if items else "")
-    return (f"<nav class='toc' id='toc'><b>Contents</b><ul>{''.join(items)}</ul></nav>"
-            if HEADING.search(body) else "")
+            entries[-1][1].append(link)
+    if not entries:
+        return ""
+    items = " · ".join(link + (f" <span class='small'>({', '.join(subs)})</span>" if subs
+                                else "") for link, subs in entries)
+    return f"<nav class='toc' id='toc'><b>Contents:</b> {items}</nav>"
 
 
 def render_html(data: ReportData) -> str:

@@ -99,13 +99,20 @@ def schematic_figure(scene: Scene, view_axis: int = 2, title: str = "") -> bytes
     colours = body_colours(scene)
     u, v = projection_axes(np.eye(3)[view_axis])
     figure, axes = plt.subplots(figsize=(7.0, 6.2))
+    from matplotlib.collections import LineCollection
+
     for index, body in enumerate(expanded.bodies):
+        segments = []
         for shape in body.shapes:
             position, rotation = shape_world_placement(shape, body.position, body.orientation)
             for line in shape_outline(shape):
                 world = position + line @ rotation.T
-                axes.plot(world @ u, world @ v, color=colours[index],
-                          linewidth=0.6 if body.motion.value == "fixed" else 1.1)
+                segments.append(np.column_stack([world @ u, world @ v]))
+        if segments:
+            axes.add_collection(LineCollection(
+                segments, colors=colours[index],
+                linewidths=0.6 if body.motion.value == "fixed" else 1.1))
+    axes.autoscale_view()
     labels = schematic_labels(scene)
     points = []
     for label in labels:
