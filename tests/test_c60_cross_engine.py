@@ -219,3 +219,34 @@ def test_each_engine_keeps_one_style():
     assert engine_style("mujoco[tuned]").marker != engine_style("mujoco[default]").marker
     assert engine_style("mujoco[tuned] dt=0.001") == engine_style("mujoco[tuned]")
     assert engine_style("mine[odd]") == engine_style("mine[odd]")   # stable for any label
+
+
+def test_conclusions_give_one_line_per_engine_and_the_model_against_the_paper():
+    import json
+
+    from clearbench.harness.report.conclusions import conclusions, standing
+    from clearbench.harness.report.page import C60_VALIDATION
+
+    studies = work_precision(RUNS)
+    budgets = [b for s in studies for b in error_budget(RUNS, s, 0.01)]
+    section = C60Section(RUNS, studies, budgets)
+    labels = sorted({r.label for r in RUNS})
+    lines = {c.label: c for c in conclusions(labels, [], section)}
+    assert list(lines)[0] == "reference[default]"
+    assert lines["mujoco[tuned]"].on.startswith("FC-1 7.29 N (-0.79 %), latch holds")
+    assert lines["mujoco[tuned]"].trip.startswith("strike 3.100 (+0 %), release 6.830 (+0 %)")
+    assert lines["mujoco[tuned]"].budget == "dt 0.004 ms (1.04 s per run)"
+    assert lines["exudyn[tuned]"].on.startswith("diverged at 0.111 ms")
+    assert lines["siconos[default]"].budget.startswith("not met: 1.49 %")
+    assert lines["siconos[default]"].library == "not run"
+    # The model's standing, from the committed validation: its FC-1 row, not a variant's
+    # (the figures are the JSON's, whatever the model's physics gives).
+    validation = json.loads(C60_VALIDATION.read_text())
+    sentence = standing(validation)
+    row = next(r for r in validation["rows"] if r["quantity"].startswith("FC-1")
+               and "variant" not in (r["note"] or ""))
+    assert sentence.startswith("The C-60 model as its source gives it (the reference engine) "
+                               f"has FC-1 {row['ours']:.3g} N against the paper's "
+                               f"{row['paper_simulated']:g} N simulated and "
+                               f"{row['paper_measured']:g} N measured "
+                               f"({100 * row['difference']:+.0f} %)")

@@ -6,8 +6,6 @@ import base64
 import html
 import json
 import re
-import shutil
-import subprocess
 
 import numpy as np
 import pandas as pd
@@ -15,6 +13,7 @@ import pytest
 
 from clearbench.harness.cli.main import main
 from clearbench.harness.measure.verdicts import VERDICTS, run_verdict
+from clearbench.harness.report import browser
 from clearbench.harness.report.figures import work_precision_figure
 from clearbench.harness.report.page import write_report
 from clearbench.harness.run.runner import Runner
@@ -175,27 +174,17 @@ def test_overview_matrix_shows_the_verdict_of_status_and_expectations(small_stor
     assert sorted(v.split(" ", 1)[1] for v in table_rows) == verdicts
 
 
-def _chromium() -> str | None:
-    return shutil.which("chromium") or shutil.which("chromium-browser")
+needs_chromium = pytest.mark.skipif(
+    browser.chromium() is None, reason="Debian's chromium is not installed (the Makefile's "
+    "test target installs it when run as root)")
 
 
+@needs_chromium
 def test_report_opens_in_headless_chromium(small_store, tmp_path):
-    browser = _chromium()
-    if browser is None:
-        pytest.skip("Debian's chromium is not installed (the Makefile's test target installs "
-                    "it when run as root)")
     paths = write_report(small_store, tmp_path / "out")
     screenshot = tmp_path / "report.png"
-    flags = [browser, "--headless", "--no-sandbox", "--disable-gpu", "--enable-logging=stderr",
-             "--v=0", f"--user-data-dir={tmp_path / 'profile'}"]
-    shot = subprocess.run(flags + [f"--screenshot={screenshot}", "--window-size=1200,1600",
-                                   paths["html"].as_uri()],
-                          capture_output=True, text=True, timeout=120)
-    assert shot.returncode == 0, shot.stderr[-2000:]
     # Page errors (script errors, failed resources) are logged as CONSOLE lines.
-    page_errors = [line for line in shot.stderr.splitlines()
-                   if "CONSOLE" in line or "Uncaught" in line or "Failed to load" in line]
-    assert not page_errors, page_errors
+    assert not browser.screenshot(paths["html"].as_uri(), screenshot, 1200, 1600)
     data = screenshot.read_bytes()
     assert data.startswith(PNG_SIGNATURE)
     import matplotlib.image
@@ -203,12 +192,11 @@ def test_report_opens_in_headless_chromium(small_store, tmp_path):
     pixels = matplotlib.image.imread(str(screenshot))
     # A rendered page has text and coloured cells: far more than one distinct colour.
     assert len(np.unique(pixels.reshape(-1, pixels.shape[-1]), axis=0)) > 20
-    dom = subprocess.run(flags + ["--dump-dom", paths["html"].as_uri()], capture_output=True,
-                         text=True, timeout=120)
-    assert dom.returncode == 0
-    assert "<table" in dom.stdout and "bouncing-ball-e0.5" in dom.stdout
+    dom, errors = browser.dump_dom(paths["html"].as_uri())
+    assert not errors
+    assert "<table" in dom and "bouncing-ball-e0.5" in dom
     # The matrix the browser built holds, cell for cell, the verdict the store implies.
-    assert _matrix_cells(dom.stdout) == _expected_verdicts(small_store)
+    assert _matrix_cells(dom) == _expected_verdicts(small_store)
 
 
 def test_pareto_front_keeps_the_non_dominated_points():
@@ -315,8 +303,7 @@ def wide_store(tmp_path_factory):
     return store
 
 
-@pytest.mark.skipif(_chromium() is None, reason="Debian's chromium is not installed (the "
-                    "Makefile's test target installs it when run as root)")
+@needs_chromium
 def test_the_page_reads_in_a_browser(wide_store, tmp_path):
     """In headless Chromium at 1366 px: the overview matrix fits the 1,100 px column, 'not
     run' is at most 10 % of its cells, no text block is wider than the page, every link of the

@@ -239,3 +239,50 @@ def test_the_c60_viewer_plays_in_headless_chromium(c60_page, tmp_path):
     changed = np.mean(np.any(np.abs(first - second) > 0.05, axis=-1))
     assert changed > 0.001, changed     # more than 0.1 % of the pixels (about 1,000)
     assert json.dumps(checks)           # the measurements are plain data
+
+
+def test_view_writes_a_page_of_the_stored_runs(tmp_path, capsys):
+    """`clearbench view`: a scene's stored runs (per engine its finest step), or one run by a
+    key prefix; a scene, run or engine the store does not have exits with status 2 naming it."""
+    from clearbench.harness.cli.main import main
+    from clearbench.harness.run.runner import Runner
+    from clearbench.harness.run.spec import make_run_spec
+    from clearbench.harness.run.store import ResultsStore
+
+    from .harness_helpers import FAKE
+
+    store = ResultsStore(tmp_path / "store")
+    specs = [make_run_spec("bouncing-ball-e0.5", "fake", time_step=dt, horizon=0.2,
+                           extra_engine_modules=FAKE) for dt in (1e-3, 5e-4)]
+    Runner(store, jobs=1, runs_per_worker=5).run_all(specs)
+    out = tmp_path / "view.html"
+    common = ["--store", str(store.directory), "--out", str(out)]
+    assert main(["view", "bouncing-ball-e0.5", *common, "--frames", "50"]) == 0
+    page = out.read_text()
+    payload = json.loads(re.search(r"class='cb-viewer-data'>(.*?)</script>", page).group(1)
+                         .replace("<\\/", "</"))
+    assert [run["label"] for run in payload["runs"]] == ["fake[default] dt 0.0005 s"]
+    assert len(payload["times"]) == 50 and "three.js" not in capsys.readouterr().err
+    key = store.dataframe()["key"].iloc[0]
+    assert main(["view", key[:8], *common]) == 0
+    for argument, named in (("nosuch", "'nosuch'"), (key[:3] + "zzz", "zzz")):
+        assert main(["view", argument, *common]) == 2
+        assert named in capsys.readouterr().err
+    assert main(["view", "bouncing-ball-e0.5", "-e", "mujoco", *common]) == 2
+    assert "--engines 'mujoco': no run of bouncing-ball-e0.5" in capsys.readouterr().err
+    assert main(["view", "bouncing-ball-e0.5", "--dt", "-1", *common]) == 2
+
+
+def test_the_docs_screenshots_start_at_their_section():
+    from tools.report_screenshots import SHOTS, starting_at
+
+    page = ("<html><body><h1>t</h1><p>a</p><h2 id='conclusions'>C</h2><figure "
+            "class='cb-viewer' id='c60-viewer'></figure><script>three</script>"
+            "<script>viewer</script></body></html>")
+    shortened = starting_at(page, "c60-viewer")
+    # the hiding script runs before three.js and the viewer's script
+    assert shortened.index("getElementById('c60-viewer')") < shortened.index("<script>three")
+    assert starting_at(page, "") == page
+    assert {name for name, *_ in SHOTS} == {
+        "report-first-screen.png", "report-conclusions.png", "viewer-strike.png",
+        "viewer-release.png", "viewer-opening.png"}

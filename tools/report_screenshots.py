@@ -35,6 +35,18 @@ SCROLL = ("<script>(() => {{ let e = document.getElementById('{target}');"
           " p.style.display = 'none'; }})();</script>")
 
 
+def starting_at(page: str, target: str) -> str:
+    """``page`` with :data:`SCROLL` for ``target`` inserted before the page's own scripts (the
+    viewer then lays out in the shortened page); unchanged for no target."""
+    if not target:
+        return page
+    if "class='cb-viewer'" in page:   # three.js and the viewer's script close the page
+        cut = page.rfind("<script>", 0, page.rfind("<script>"))
+    else:
+        cut = page.rfind("</body>")
+    return page[:cut] + SCROLL.format(target=target) + page[cut:]
+
+
 def take(report: Path, out: Path) -> list[Path]:
     """Write every screenshot of :data:`SHOTS` of ``report`` into ``out``.
 
@@ -52,12 +64,7 @@ def take(report: Path, out: Path) -> list[Path]:
         for name, query, target, width, height in SHOTS:
             copy = Path(folder) / f"{target or 'top'}.html"
             if not copy.exists():
-                script = SCROLL.format(target=target) if target else ""
-                # before the page's own scripts: the viewer lays out in the shortened page
-                viewer = "class='cb-viewer'" in page
-                cut = (page.rfind("<script>", 0, page.rfind("<script>")) if viewer
-                       else page.rfind("</body>"))
-                copy.write_text(page[:cut] + script + page[cut:], encoding="utf-8")
+                copy.write_text(starting_at(page, target), encoding="utf-8")
             errors = browser.screenshot(copy.as_uri() + query, out / name, width, height)
             if errors:
                 raise browser.BrowserError(f"{name}: the page logged {errors}")
