@@ -268,25 +268,23 @@ TRIP_HEAD = ["engine", "dt [ms]", "horizon [ms]", "status", "strike [ms] (vs ref
              "x reference"]
 
 
+def run_summary(section: C60Section, run: C60RunFigures) -> str:
+    """What a finished C-60 run comes to, against the reference's finest run (none for that
+    run itself): c60-on's FC-1 and the latch, c60-trip's events."""
+    reference = reference_run(section.runs, run.scene_name, run.horizon)
+    if reference is not None and reference.key == run.key:
+        reference = None     # the yardstick itself: nothing to compare with
+    if run.scene_name == ON_SCENE:
+        change = relative(run.fc1, reference.fc1) if reference else math.nan
+        versus = "" if math.isnan(change) else f" ({100 * change:+.2g} %)"
+        return f"FC-1 {format_value(run.fc1, 'N')}{versus}, latch {latch_text(run)}"
+    return ", ".join(f"{c.event} {c.text()}" for c in compare_events(run, reference))
+
+
 def c60_cell_texts(section: C60Section) -> dict[str, str]:
-    """Run key -> what the overview's cell shows for a finished C-60 run: c60-on's FC-1
-    against the reference's and the latch, c60-trip's events against the reference's."""
-    texts = {}
-    for run in section.runs:
-        if run.status != "ok":
-            continue
-        reference = reference_run(section.runs, run.scene_name, run.horizon)
-        if reference is not None and reference.key == run.key:
-            reference = None     # the yardstick itself: nothing to compare with
-        if run.scene_name == ON_SCENE:
-            change = relative(run.fc1, reference.fc1) if reference else math.nan
-            versus = "" if math.isnan(change) else f" ({100 * change:+.2g} %)"
-            texts[run.key] = f"FC-1 {format_value(run.fc1, 'N')}{versus}, latch " \
-                             f"{latch_text(run)}"
-        elif run.scene_name == TRIP_SCENE:
-            texts[run.key] = ", ".join(f"{c.event} {c.text()}"
-                                       for c in compare_events(run, reference))
-    return texts
+    """Run key -> what the overview's cell shows for a finished C-60 run
+    (:func:`run_summary`)."""
+    return {run.key: run_summary(section, run) for run in section.runs if run.status == "ok"}
 
 
 def _budget_cell(step: BudgetStep | None) -> str:

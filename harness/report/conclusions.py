@@ -13,13 +13,7 @@ from clearbench.harness.c60.cross_engine import ON_SCENE, REFERENCE_LABEL, TRIP_
 from clearbench.harness.measure.headline import format_value
 from clearbench.harness.measure.verdicts import run_verdict
 from clearbench.harness.report import c60_motion
-from clearbench.harness.report.c60_section import (
-    C60Section,
-    compare_events,
-    latch_text,
-    reference_run,
-    relative,
-)
+from clearbench.harness.report.c60_section import C60Section, run_summary
 
 #: The error budget the conclusions quote (the table has every one).
 CONCLUSION_BUDGET = 0.01
@@ -53,45 +47,23 @@ def _finest(runs, label: str, scene_name: str):
 
 
 def _status(run) -> str:
-    if run.status == "unsupported":
-        return "unsupported"
     text = run.status
     if math.isfinite(run.simulated_until) and run.simulated_until < run.horizon:
         text += f" at {run.simulated_until:.3g} ms"
     return text
 
 
-def on_text(section: C60Section | None, label: str) -> str:
-    """FC-1 and its difference from the reference's, and the latch, of the label's finest
-    finished c60-on run."""
-    run = _finest(section.runs, label, ON_SCENE) if section else None
+def c60_text(section: C60Section | None, label: str, scene_name: str) -> str:
+    """The label's finest finished run of the scene (c60-on: FC-1 against the reference's
+    and the latch; c60-trip: each event against the reference's), or how it ended."""
+    run = _finest(section.runs, label, scene_name) if section else None
     if run is None:
         return "not run"
     if run.status == "unsupported":
         return "unsupported"
     if run.status != "ok":
         return f"{_status(run)} (dt {run.time_step:g} ms)"
-    reference = reference_run(section.runs, ON_SCENE, run.horizon)
-    change = relative(run.fc1, reference.fc1) if reference is not None else math.nan
-    versus = "" if math.isnan(change) or run.key == reference.key else f" ({100 * change:+.2g} %)"
-    return f"FC-1 {format_value(run.fc1, 'N')}{versus}, latch {latch_text(run)} " \
-           f"(dt {run.time_step:g} ms)"
-
-
-def trip_text(section: C60Section | None, label: str) -> str:
-    """Each trip event of the label's finest finished c60-trip run against the reference's."""
-    run = _finest(section.runs, label, TRIP_SCENE) if section else None
-    if run is None:
-        return "not run"
-    if run.status == "unsupported":
-        return "unsupported"
-    if run.status != "ok":
-        return f"{_status(run)} (dt {run.time_step:g} ms)"
-    reference = reference_run(section.runs, TRIP_SCENE, run.horizon)
-    if reference is not None and reference.key == run.key:
-        reference = None
-    return ", ".join(f"{c.event} {c.text()}" for c in compare_events(run, reference)) + \
-        f" (dt {run.time_step:g} ms)"
+    return f"{run_summary(section, run)} (dt {run.time_step:g} ms)"
 
 
 def budget_text(section: C60Section | None, label: str) -> str:
@@ -130,7 +102,7 @@ def conclusions(labels: Sequence[str], sections: Sequence, c60: C60Section | Non
                and not (s.scene is not None and "stiff" in s.scene.tags)]
     stiff = [s for s in sections if s.scene is not None and "stiff" in s.scene.tags]
     ordered = sorted(labels, key=lambda label: (label != REFERENCE_LABEL, label))
-    return [Conclusion(label, on_text(c60, label), trip_text(c60, label),
+    return [Conclusion(label, c60_text(c60, label, ON_SCENE), c60_text(c60, label, TRIP_SCENE),
                        budget_text(c60, label), pass_count(library, label),
                        pass_count(stiff, label) if stiff else "not run")
             for label in ordered]
