@@ -11,9 +11,9 @@ from dataclasses import dataclass
 
 from clearbench.harness.c60.cross_engine import ON_SCENE, REFERENCE_LABEL, TRIP_SCENE
 from clearbench.harness.measure.headline import format_value
-from clearbench.harness.measure.verdicts import run_verdict
 from clearbench.harness.report import c60_motion
 from clearbench.harness.report.c60_section import C60Section, run_summary
+from clearbench.harness.report.overview import row_verdict
 
 #: The error budget the conclusions quote (the table has every one).
 CONCLUSION_BUDGET = 0.01
@@ -83,9 +83,8 @@ def budget_text(section: C60Section | None, label: str) -> str:
 def pass_count(sections: Sequence, label: str) -> str:
     """How many of ``sections`` (report SceneSections) the label's run at the scene's step
     passes, with the other verdicts counted."""
-    verdicts = [run_verdict(s.representative[label]["status"],
-                            s.representative[label].get("expectations_passed"))
-                for s in sections if label in s.representative]
+    verdicts = [row_verdict(s.representative[label]) for s in sections
+                if label in s.representative]
     if not verdicts:
         return "not run"
     passed = verdicts.count("pass")

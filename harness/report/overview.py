@@ -49,6 +49,13 @@ def engine_columns(labels: Sequence[str]) -> list[str]:
     return sorted(names, key=lambda name: (name != REFERENCE_ENGINE, name))
 
 
+def row_verdict(row) -> str:
+    """The verdict of a stored run (a dict or DataFrame row): its status and its expectations
+    together (:func:`~clearbench.harness.measure.verdicts.run_verdict`); the one place the
+    report asks for it."""
+    return run_verdict(row["status"], row.get("expectations_passed"))
+
+
 def failed_expectations(row: dict) -> list[dict]:
     """The expectation results of a run that failed (each with its ``detail``: the value
     against its limit)."""
@@ -86,7 +93,7 @@ def cell_lines(representative: dict, engine: str, scene: Scene | None,
                     key=lambda label: (engine_of(label)[1] != "default", label))
     for label in labels:
         row = representative[label]
-        verdict = run_verdict(row["status"], row.get("expectations_passed"))
+        verdict = row_verdict(row)
         figure = run_figure(row, scene, (c60_texts or {}).get(label, ""))
         failed = [r.get("name", "") for r in failed_expectations(row)]
         title = "; ".join(filter(None, [row.get("message") or "", figure,

@@ -34,7 +34,7 @@ from clearbench.harness.measure.headline import (
     scene_metric_names,
 )
 from clearbench.harness.measure.units import unit_text
-from clearbench.harness.measure.verdicts import VERDICTS, run_verdict, verdict_text
+from clearbench.harness.measure.verdicts import VERDICTS, verdict_text
 from clearbench.harness.report.c60_section import (
     EVENT_BOUND,
     FLAG,
@@ -56,6 +56,7 @@ from clearbench.harness.report.overview import (
     engine_columns,
     matrix_html,
     matrix_markdown,
+    row_verdict,
 )
 from clearbench.harness.report.readme_table import results_document, write_results
 from clearbench.harness.report.viewer.payload import CSS as VIEWER_CSS
@@ -265,7 +266,7 @@ def _verdict_body(verdict: str, text: str) -> tuple[str, str]:
 def _run_verdict_td(run) -> str:
     """A per-scene table's verdict cell: the run's verdict (status and expectations together,
     as in the overview), its colour, and the message and failed expectations as its title."""
-    colour, body = _verdict_body(run_verdict(run["status"], run["expectations_passed"]), "")
+    colour, body = _verdict_body(row_verdict(run), "")
     return f"<td style='background:{colour}' title='{_esc(_run_title(run))}'>{body}</td>"
 
 
@@ -586,7 +587,7 @@ def render_markdown(data: ReportData, figure_files: dict, c60_figure_files: dict
         for _, run in section.runs.sort_values(["label", "time_step"]).iterrows():
             figures = json.loads(run["metrics"] or "{}")
             role = " (fine ref)" if str(run["campaign"]).endswith(FINE_SUFFIX) else ""
-            verdict = verdict_text(run_verdict(run["status"], run["expectations_passed"]))
+            verdict = verdict_text(row_verdict(run))
             lines.append(f"| {run['label']}{role} | {run['time_step']:.3g} | {verdict} | "
                          + " | ".join(format_value(figures.get(c)) for c in columns)
                          + f" | {format_value(run['stepping_seconds_per_step'], 's')} |")
