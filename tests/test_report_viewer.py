@@ -286,3 +286,41 @@ def test_the_docs_screenshots_start_at_their_section():
     assert {name for name, *_ in SHOTS} == {
         "report-first-screen.png", "report-conclusions.png", "viewer-strike.png",
         "viewer-release.png", "viewer-opening.png"}
+
+
+def test_time_series_keep_the_finished_runs_readable(c60_trip):
+    """Every engine on one plot per quantity: the y range holds the finished runs, so a run
+    that diverged (here its hook turned 1e6 degrees) leaves the plot instead of squashing
+    the others; the figure marks the trip's events."""
+    from clearbench.harness.c60.cross_engine import C60RunFigures
+    from clearbench.harness.report.c60_motion import (
+        ShownRun,
+        motion_series,
+        readable_limits,
+        time_series_figure,
+    )
+
+    calm = np.sin(np.linspace(0, 3, 50))
+    wild = calm.copy()
+    wild[-5:] = 1e6
+    low, high = readable_limits([(calm, True), (wild, False)])
+    assert low == pytest.approx(calm.min() - 0.08 * np.ptp(calm))
+    assert high == pytest.approx(calm.max() + 0.08 * np.ptp(calm))
+    assert readable_limits([(wild, False)])[1] > 1e6     # nothing finished: every curve
+
+    runs = _c60_runs(c60_trip, 2)
+    shown = []
+    for k, (run, status) in enumerate(zip(runs, ("ok", "diverged"), strict=True)):
+        figures = C60RunFigures(key=f"k{k}", scene_name="c60-trip", label=f"engine{k}[default]",
+                                engine_version="x", time_step=1e-3, horizon=8.5, status=status,
+                                message="", strike=3.1, release=6.8, opening=7.6)
+        shown.append(ShownRun(figures, run.trajectory))
+    series = motion_series(c60_trip, shown[0].trajectory)
+    assert list(series) == ["hook angle [deg]", "tripping-bar angle [deg]", "C7 gap [mm]",
+                            "FC-1: C7 force [N]"]
+    hook = c60_trip.body_index("hook")
+    # the synthetic hook turns by 20 deg sin(...) about z: its angle since t = 0, in degrees
+    expected = 20 * np.sin(np.linspace(0.0, 8.5, 851) * (1 + 0.3 * hook))
+    assert np.allclose(series["hook angle [deg]"], expected, atol=1e-6)
+    png = time_series_figure(c60_trip, shown)
+    assert png is not None and png.startswith(PNG_SIGNATURE)
