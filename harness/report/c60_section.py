@@ -139,11 +139,6 @@ def reference_run(runs, scene_name: str, horizon: float) -> C60RunFigures | None
     return min(candidates, key=lambda r: r.time_step) if candidates else None
 
 
-def _reference_value(runs, scene_name: str, horizon: float, attribute: str) -> float:
-    reference = reference_run(runs, scene_name, horizon)
-    return math.nan if reference is None else getattr(reference, attribute)
-
-
 @dataclass(frozen=True)
 class EventComparison:
     """One trip event of a run against the reference's: times [ms], relative difference of
@@ -166,7 +161,10 @@ class EventComparison:
 
 def compare_events(run: C60RunFigures, reference: C60RunFigures | None
                    ) -> list[EventComparison]:
-    """Each trip event (strike, release, opening) of ``run`` against the reference's."""
+    """Each trip event (strike, release, opening) of ``run`` against the reference's (not
+    compared when ``run`` is the reference's run itself)."""
+    if reference is not None and reference.key == run.key:
+        reference = None
     out = []
     for event in c60_motion.EVENTS:
         time = getattr(run, event)
@@ -235,11 +233,20 @@ def _tail_cells(run: C60RunFigures) -> list[str]:
             format_value(run.ratio_to_reference)]
 
 
+def table_runs(runs, scene_name: str) -> list[C60RunFigures]:
+    """The runs of one scene in the order of its table: the reference first, then by engine
+    label and step."""
+    return sorted((r for r in runs if r.scene_name == scene_name),
+                  key=lambda r: (r.label != REFERENCE_LABEL, r.label, r.time_step))
+
+
 def on_rows(runs) -> list[list[str]]:
     """Cells of the c60-on table (plain text)."""
     rows = []
-    for run in (r for r in runs if r.scene_name == ON_SCENE):
-        fc1_ref = _reference_value(runs, ON_SCENE, run.horizon, "fc1")
+    for run in table_runs(runs, ON_SCENE):
+        reference = reference_run(runs, ON_SCENE, run.horizon)
+        fc1_ref = reference.fc1 if reference is not None and reference.key != run.key \
+            else math.nan
         others = ", ".join(f"{k} {format_value(v)}" for k, v in run.functional_conditions.items()
                            if k != "FC-1")
         rows.append(_head_cells(run) + [format_value(run.fc1) + _difference(run.fc1, fc1_ref),
@@ -250,7 +257,7 @@ def on_rows(runs) -> list[list[str]]:
 def trip_rows(runs) -> list[list[str]]:
     """Cells of the c60-trip table (plain text): each event against the reference's."""
     rows = []
-    for run in (r for r in runs if r.scene_name == TRIP_SCENE):
+    for run in table_runs(runs, TRIP_SCENE):
         reference = reference_run(runs, TRIP_SCENE, run.horizon)
         events = [c.text() for c in compare_events(run, reference)]
         rows.append(_head_cells(run) + events + _tail_cells(run))
@@ -380,7 +387,7 @@ SERIES_CAPTION = ("Every engine's finest run against time: the hook's and the tr
 def _table_html(head: list[str], rows: list[list[str]], runs, scene_name: str,
                 caption: str) -> str:
     """The table with the status's message as its tooltip and each joint's excess folded."""
-    mine = [r for r in runs if r.scene_name == scene_name]
+    mine = table_runs(runs, scene_name)
     status_column, joint_column = head.index("status"), len(head) - 4
     body = []
     for cells, run in zip(rows, mine, strict=True):
@@ -394,7 +401,8 @@ def _table_html(head: list[str], rows: list[list[str]], runs, scene_name: str,
             else:
                 tds.append(_esc(cell))
         body.append(tds)
-    return table(head, body, caption, raw=True, css_class="wide")
+    numeric = (1, 2, len(head) - 3, len(head) - 2, len(head) - 1)
+    return table(head, body, caption, raw=True, css_class="wide", numeric=numeric)
 
 
 def motion_html(section: C60Section) -> str:

@@ -31,8 +31,9 @@ def table(head: Sequence[str], rows: Sequence[Sequence[str]], caption: str = "",
     a ``caption`` above it; columns ``numeric`` right-aligned."""
     cell = (lambda value: str(value)) if raw else esc
     header = "".join(f"<th>{esc(h)}</th>" for h in head)
+    number = " class='num'"
     body = "".join(
-        "<tr>" + "".join(f"<td{' class=num' if k in numeric else ''}>{cell(value)}</td>"
+        "<tr>" + "".join(f"<td{number if k in numeric else ''}>{cell(value)}</td>"
                          for k, value in enumerate(row)) + "</tr>"
         for row in rows)
     cls = f" class='{esc(css_class)}'" if css_class else ""

@@ -231,7 +231,8 @@ h1{font-size:1.6em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-to
 table{border-collapse:collapse;margin:.6em 0;font-size:.86em}
 caption{caption-side:top;text-align:left;font-weight:600;padding:.2em 0}
 th,td{border:1px solid #ccc;padding:.25em .5em;text-align:left;vertical-align:top}
-th{background:#f3f3f3}td.num{text-align:right;font-variant-numeric:tabular-nums}
+th{background:#f3f3f3}td.num{text-align:right;font-variant-numeric:tabular-nums;
+overflow-wrap:normal;white-space:nowrap}
 .scroll{max-width:100%;overflow-x:auto}
 .status{font-weight:600}.small{color:#555;font-size:.85em}img{max-width:100%}
 .figs{display:grid;grid-template-columns:repeat(2,minmax(0,1fr));gap:1em}

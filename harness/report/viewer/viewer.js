@@ -159,6 +159,7 @@
     layout() {
       const canvas = this.renderer.domElement;
       const width = this.root.clientWidth;
+      if (width < 16) { this.cell = null; return; }      // hidden (a folded or cut page)
       const n = this.views.length;
       this.columns = Math.min(n, width < 700 ? 2 : 3);
       this.rows = Math.ceil(n / this.columns);
@@ -238,7 +239,7 @@
     }
 
     render() {
-      if (!this.renderer || !this.cell) return;
+      if (!this.renderer || !this.cell || this.cell.h < 8) return;
       const r = this.renderer;
       const heightAll = this.cell.h * this.rows;
       r.setScissorTest(true);
@@ -257,6 +258,7 @@
     // The schematic's labels over the first view, where their points project.
     placeLabels() {
       const layer = this.root.querySelector(".cb-labels");
+      if (!this.cell) return;
       const show = this.root.querySelector(".cb-show-labels").checked;
       layer.style.display = show ? "" : "none";
       if (!show || !this.views) return;
