@@ -240,7 +240,8 @@ overflow-wrap:normal;white-space:nowrap}
 table.matrix{width:100%;table-layout:fixed;font-size:.8em}table.matrix th.scene{width:12%}
 table.matrix .line{padding:.15em .3em;margin:1px 0;border-radius:2px}
 td.notrun{color:#777;background:#fafafa}
-table.conclusions{font-size:.82em}.toc{font-size:.9em;margin:.5em 0 1em}
+table.conclusions{font-size:.82em}table.conclusions td:first-child{white-space:nowrap}
+.toc{font-size:.9em;margin:.5em 0 1em}
 dl.glossary{display:grid;grid-template-columns:max-content 1fr;gap:.2em 1em;font-size:.9em}
 dl.glossary dt{font-weight:600}dl.glossary dd{margin:0}
 details>summary{cursor:pointer}
