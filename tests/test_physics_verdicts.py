@@ -17,7 +17,7 @@ import pytest
 from clearbench.adapters import all_availability
 from clearbench.adapters.trajectory import RunStatus
 from clearbench.harness.measure.figures import JOINT_BREAK_FRACTION
-from clearbench.harness.measure.verdicts import ENERGY_GROWTH_ALLOWANCE
+from clearbench.harness.measure.kinds.invariants import ENERGY_GROWTH_ALLOWANCE
 from clearbench.harness.run.runner import Runner
 from clearbench.harness.run.spec import make_run_spec
 from clearbench.harness.run.store import ResultsStore

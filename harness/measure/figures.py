@@ -60,12 +60,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from clearbench.adapters.energy_guard import ENERGY_EXPECTATIONS
 from clearbench.adapters.trajectory import RunStatus, Trajectory
 from clearbench.harness.measure import series as metrics
-from clearbench.harness.measure.expectation_figures import ExpectationResult, evaluate
-from clearbench.harness.measure.verdicts import ANALYTIC_ERROR, analytic_error, judgement
+from clearbench.harness.measure.expectation_figures import evaluate, evaluate_implied
+from clearbench.harness.measure.verdicts import analytic_error, has_analytic_error, judgement
 from clearbench.scenarios.bodies import Motion
+from clearbench.scenarios.expectation_kinds import body_stays, energy_may_not_grow
 from clearbench.scenarios.scales import contact_feature_sizes, scene_size
 from clearbench.scenarios.scene import Scene
 
@@ -87,8 +87,6 @@ JOINT_BREAK_FRACTION = 0.05
 #: Ideal-joint axes (revolute) or relative orientations (prismatic, fixed) farther apart than
 #: this [rad] (5.7 degrees) mean the joint came apart.
 JOINT_BREAK_ANGLE = 0.1
-#: Expectation kinds whose body must not move.
-STICK_KINDS = frozenset({"incline_stick", "sticks"})
 
 
 @dataclass(frozen=True)
@@ -105,7 +103,7 @@ class Measurement:
 
 def has_analytic_reference(scene: Scene) -> bool:
     """True when an expectation of the scene has an analytic solution to measure error by."""
-    return any(e.kind in ANALYTIC_ERROR for e in scene.expectations)
+    return any(has_analytic_error(e.kind) for e in scene.expectations)
 
 
 def first_non_finite(trajectory: Trajectory) -> str | None:
@@ -127,14 +125,15 @@ def first_non_finite(trajectory: Trajectory) -> str | None:
 
 def _expectation_results(scene: Scene, trajectory: Trajectory, out: _Collector):
     """Every expectation's figures (also flattened into ``NAME.FIGURE`` figures), pass/fail,
-    criterion and detail (:mod:`.verdicts`), the implied energy balance check
-    (:func:`_energy_balance_result`), and the analytic error with its source."""
+    criterion and detail (:mod:`.verdicts`), the implied checks that apply
+    (:func:`~.expectation_figures.evaluate_implied`), and the analytic error with its
+    source."""
     expectations = {e.name: e for e in scene.expectations}
     results = []
     errors = []
     evaluated = evaluate(scene, trajectory)
-    implied = _energy_balance_result(scene, out)
-    for result in evaluated + ([implied] if implied is not None else []):
+    implied = evaluate_implied(scene, trajectory, out.figures)
+    for result in evaluated + implied:
         figures = {k: float(v) for k, v in result.figures.items()}
         expectation = expectations.get(result.name)
         verdict = judgement(scene, result.kind, expectation.body if expectation else None,
@@ -152,25 +151,6 @@ def _expectation_results(scene: Scene, trajectory: Trajectory, out: _Collector):
         return results, math.nan, ""
     value, name = max(errors)
     return results, value, f"analytic ({name})"
-
-
-#: Name of the implied expectation every run gets where the scene's energy balance is
-#: computed and the scene lists no energy expectation of its own.
-ENERGY_BALANCE = "energy_balance"
-
-
-def _energy_balance_result(scene: Scene, out: _Collector) -> ExpectationResult | None:
-    """The energy check every run gets when the energy balance is computed (no driver, point
-    force, moment or law load: ``energy_growth`` was measured) and the scene lists no energy
-    expectation: restitution e <= 1, friction and dampers only take energy, so a growth
-    beyond :data:`~.verdicts.ENERGY_GROWTH_ALLOWANCE` of the energy scale is wrong physics,
-    whatever the scene asks."""
-    growth = out.figures.get("energy_growth")
-    if growth is None or any(e.kind in ENERGY_EXPECTATIONS for e in scene.expectations):
-        return None
-    return ExpectationResult(ENERGY_BALANCE, ENERGY_BALANCE,
-                             {"energy_growth_relative": growth}, "energy_growth_relative",
-                             "implied: the scene's energy balance is computed")
 
 
 class _Collector:
@@ -325,7 +305,7 @@ def _drivers(scene, trajectory, out: _Collector, reasons: list[str]) -> None:
 def _stiction(scene, trajectory, out: _Collector) -> None:
     worst = None
     for expectation in scene.expectations:
-        if expectation.kind not in STICK_KINDS:
+        if not body_stays(expectation.kind):
             continue
         start = float(expectation.parameters.get("start_time", 0.0))
         end = expectation.parameters.get("end_time")
@@ -351,7 +331,7 @@ def _energy(scene, trajectory, out: _Collector, reasons: list[str]) -> None:
     out.put("energy_growth", growth)
     free_rise, free_scale = metrics.energy_growth_contact_free(scene, trajectory, energy)
     out.put("energy_growth_contact_free", free_rise / free_scale)
-    must_not_grow = any(e.kind in ENERGY_EXPECTATIONS for e in scene.expectations)
+    must_not_grow = any(energy_may_not_grow(e.kind) for e in scene.expectations)
     if must_not_grow and growth > ENERGY_GROWTH_LIMIT:
         reasons.append(f"energy grew by {100 * growth:.3g} % of its scale {rise_scale:.3g} "
                        "(energy that may not grow)")

@@ -14,6 +14,7 @@ from clearbench.harness.measure.headline import format_value
 from clearbench.harness.report import c60_motion
 from clearbench.harness.report.c60_section import C60Section, run_summary
 from clearbench.harness.report.overview import row_verdict
+from clearbench.scenarios.tags import STIFF
 
 #: The error budget the conclusions quote (the table has every one).
 CONCLUSION_BUDGET = 0.01
@@ -98,8 +99,8 @@ def conclusions(labels: Sequence[str], sections: Sequence, c60: C60Section | Non
     """One line per engine label (the reference first). ``sections``: the report's scene
     sections (the C-60 scenes and the stiff suite are counted apart from the library)."""
     library = [s for s in sections if s.name not in (ON_SCENE, TRIP_SCENE)
-               and not (s.scene is not None and "stiff" in s.scene.tags)]
-    stiff = [s for s in sections if s.scene is not None and "stiff" in s.scene.tags]
+               and not (s.scene is not None and STIFF in s.scene.tags)]
+    stiff = [s for s in sections if s.scene is not None and STIFF in s.scene.tags]
     ordered = sorted(labels, key=lambda label: (label != REFERENCE_LABEL, label))
     return [Conclusion(label, c60_text(c60, label, ON_SCENE), c60_text(c60, label, TRIP_SCENE),
                        budget_text(c60, label), pass_count(library, label),

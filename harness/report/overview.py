@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from clearbench.harness.measure.headline import METRIC_LABELS, format_value, headline
 from clearbench.harness.measure.units import unit_text
-from clearbench.harness.measure.verdicts import VERDICTS, run_verdict, verdict_text
+from clearbench.harness.measure.verdicts import VERDICTS, criteria, run_verdict, verdict_text
 from clearbench.harness.report.html_parts import esc, heading
 from clearbench.scenarios.scene import Scene
 
@@ -35,6 +35,7 @@ class CellLine:
     verdict: str
     figure: str
     title: str
+    failed_kinds: tuple = ()
 
 
 def engine_of(label: str) -> tuple[str, str]:
@@ -98,7 +99,8 @@ def cell_lines(representative: dict, engine: str, scene: Scene | None,
         failed = [r.get("name", "") for r in failed_expectations(row)]
         title = "; ".join(filter(None, [row.get("message") or "", figure,
                                         f"failed: {', '.join(failed)}" if failed else ""]))
-        lines.append(CellLine(label, engine_of(label)[1], verdict, figure, title))
+        kinds = tuple(r.get("kind", "") for r in failed_expectations(row))
+        lines.append(CellLine(label, engine_of(label)[1], verdict, figure, title, kinds))
     return lines
 
 
@@ -178,6 +180,12 @@ def words_used(lines: Sequence[CellLine]) -> dict[str, str]:
         for word, meaning in FIGURE_WORDS.items():
             if line.figure.startswith(word) or f" {word} " in f" {line.figure} ":
                 used[word] = meaning
+        rules = criteria()
+        for kind in line.failed_kinds:
+            if kind in rules:
+                used[f"failed: {kind.replace('_', ' ')}"] = (
+                    f"the scene's {kind} expectation failed; it passes when "
+                    f"{rules[kind].passes_when} (the cell gives the value against the limit)")
     return used
 
 

@@ -66,6 +66,7 @@ from clearbench.harness.studies.campaign.report import load_written_sections
 from clearbench.harness.studies.campaign.report import render_markdown as campaign_section_markdown
 from clearbench.harness.studies.sweep import work_precision_points
 from clearbench.scenarios.scene import Scene
+from clearbench.scenarios.tags import STIFF
 
 LOG = logging.getLogger(__name__)
 
@@ -136,7 +137,7 @@ def collect(store: ResultsStore, figures: bool = True,
         if figures:
             _figures(store, section, colours)
         sections.append(section)
-    sections.sort(key=lambda s: (s.scene is not None and "stiff" in s.scene.tags, s.name))
+    sections.sort(key=lambda s: (s.scene is not None and STIFF in s.scene.tags, s.name))
     return ReportData(frame, sections, sorted(frame["label"].unique()) if len(frame) else [],
                       approximations, str(store.directory),
                       datetime.now(UTC).isoformat(timespec="seconds"),
@@ -278,7 +279,7 @@ def overview_rows(data: ReportData, stiff: bool, engines: list[str]) -> list:
     texts = c60_cell_texts(data.c60_engines) if data.c60_engines else {}
     rows = []
     for section in data.sections:
-        if (section.scene is not None and "stiff" in section.scene.tags) != stiff:
+        if (section.scene is not None and STIFF in section.scene.tags) != stiff:
             continue
         by_label = {label: texts.get(row["key"], "")
                     for label, row in section.representative.items()}
