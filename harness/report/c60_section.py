@@ -34,7 +34,7 @@ from clearbench.harness.measure.headline import format_value
 from clearbench.harness.report import c60_motion
 from clearbench.harness.report.figures import c60_work_precision_figure
 from clearbench.harness.report.html_parts import esc as _esc
-from clearbench.harness.report.html_parts import heading, png_figure, table
+from clearbench.harness.report.html_parts import heading, length_text, png_figure, table
 from clearbench.harness.report.schematic import schematic_figure
 from clearbench.harness.report.viewer.payload import viewer_fragment, viewer_payload
 
@@ -194,18 +194,8 @@ def latch_text(run: C60RunFigures) -> str:
 
 
 def length(value: float, unit: str = "mm") -> str:
-    """A length given in ``unit`` (mm, the C-60's), written in mm from 0.1 mm up and in µm
-    below (``7.2e-04 mm`` reads as ``0.72 µm``)."""
-    if value is None or not math.isfinite(value):
-        return "—"
-    scale = {"m": 1e3, "cm": 10.0, "mm": 1.0, "um": 1e-3}[unit]
-    millimetres = value * scale
-    if millimetres == 0:
-        return "0"
-    if abs(millimetres) >= 0.1:
-        return f"{millimetres:.3g} mm"
-    micrometres = 1e3 * millimetres
-    return f"{micrometres:.3g} µm" if abs(micrometres) >= 1e-3 else f"{micrometres:.1e} µm"
+    """A C-60 length (given in mm), as :func:`.html_parts.length_text` writes it."""
+    return length_text(value, unit)
 
 
 def _joints(run: C60RunFigures) -> tuple[str, str]:

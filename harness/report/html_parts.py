@@ -6,8 +6,11 @@ from __future__ import annotations
 
 import base64
 import html
+import math
 import re
 from collections.abc import Sequence
+
+from clearbench.scenarios.units import LENGTH_UNITS
 
 
 def esc(value) -> str:
@@ -17,6 +20,23 @@ def esc(value) -> str:
 def slug(text: str) -> str:
     """An id for a heading: lower case, runs of other characters as one ``-``."""
     return re.sub(r"[^a-z0-9]+", "-", str(text).lower()).strip("-") or "section"
+
+
+def length_text(value: float, unit: str) -> str:
+    """A length given in ``unit`` (a key of :data:`~clearbench.scenarios.units.LENGTH_UNITS`)
+    in the unit that reads best: m from 1 m up, mm from 0.1 mm, µm below (``7.2e-04 mm``
+    reads as ``0.72 µm``, ``4.83e-05 m`` as ``48.3 µm``); "—" when missing."""
+    if value is None or not math.isfinite(value):
+        return "—"
+    metres = value * LENGTH_UNITS[unit]
+    if metres == 0:
+        return "0"
+    if abs(metres) >= 1.0:
+        return f"{metres:.3g} m"
+    if abs(metres) >= 1e-4:
+        return f"{1e3 * metres:.3g} mm"
+    micrometres = 1e6 * metres
+    return f"{micrometres:.3g} µm" if abs(micrometres) >= 1e-3 else f"{micrometres:.1e} µm"
 
 
 def heading(level: int, text: str, ident: str | None = None) -> str:

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from clearbench.harness.measure.headline import METRIC_LABELS, format_value, headline
 from clearbench.harness.measure.units import unit_text
 from clearbench.harness.measure.verdicts import VERDICTS, criteria, run_verdict, verdict_text
-from clearbench.harness.report.html_parts import esc, heading
+from clearbench.harness.report.html_parts import esc, heading, length_text
 from clearbench.scenarios.scene import Scene
 
 REFERENCE_ENGINE = "reference"
@@ -77,7 +77,9 @@ def run_figure(row: dict, scene: Scene | None, c60_text: str = "") -> str:
     name, value = headline(scene, figures) if scene is not None else ("", math.nan)
     if not name:
         return ""
-    label = METRIC_LABELS.get(name, (name, ""))[0]
+    label, kind = METRIC_LABELS.get(name, (name, ""))
+    if kind == "length":
+        return f"{label} {length_text(value, scene.units.length)}"
     return f"{label} {format_value(value, unit_text(name, scene, short=True))}"
 
 
