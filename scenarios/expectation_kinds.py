@@ -130,6 +130,9 @@ class ExpectationKind:
     energy_may_not_grow : bool
         The expectation says the scene's mechanical energy may not grow (the engines' energy
         guard and the harness's energy verdict read it).
+    energy_conserved : bool
+        The expectation says the energy is conserved: it judges a loss as well as a gain (the
+        harness's implied conservation check then leaves the scene to it).
     body_stays : bool
         The expectation says its body must not move (between ``start_time`` and ``end_time``
         when it has them): the run's stiction figures are measured on it.
@@ -144,6 +147,7 @@ class ExpectationKind:
     relations: tuple[Relation, ...] = ()
     scene_checks: tuple = ()
     energy_may_not_grow: bool = False
+    energy_conserved: bool = False
     body_stays: bool = False
 
     def __post_init__(self) -> None:
@@ -222,6 +226,13 @@ def energy_may_not_grow(kind: str) -> bool:
     """Whether an expectation of ``kind`` says the scene's energy may not grow."""
     declared = EXPECTATION_KINDS.get(kind)
     return declared is not None and declared.energy_may_not_grow
+
+
+def judges_energy_loss(kind: str) -> bool:
+    """Whether an expectation of ``kind`` says the scene's energy is conserved (a loss fails
+    it)."""
+    declared = EXPECTATION_KINDS.get(kind)
+    return declared is not None and declared.energy_conserved
 
 
 def body_stays(kind: str) -> bool:
@@ -374,6 +385,17 @@ ROCKING_RATIO = declare_kind(ExpectationKind(
         "(b/h < 1.41)"),),
     scene_checks=(gravity_is_the_scenes,),
 ))
+HOOP_OVER_EDGE = declare_kind(ExpectationKind(
+    "hoop_over_edge",
+    "a hoop sliding without friction and spin at v0 toward a straight edge (its lowest point "
+    "edge_distance before it) pivots about the edge, its centre on the circle of radius r, "
+    "leaves it where cos(theta) = (2 + v0^2/(g r))/3, then flies: the centre's path",
+    {"initial_speed": _V0, "radius": Parameter(LENGTH, POSITIVE, meaning="hoop radius"),
+     "gravity": _G,
+     "edge_distance": Parameter(LENGTH, NON_NEGATIVE,
+                                meaning="lowest point to the edge at t = 0, along the motion")},
+    scene_checks=(gravity_is_the_scenes,),
+))
 STICKS = declare_kind(ExpectationKind(
     "sticks",
     "the body must not move between start_time and end_time",
@@ -389,7 +411,7 @@ ENERGY_NON_INCREASING = declare_kind(ExpectationKind(
 ))
 ENERGY_CONSERVED = declare_kind(ExpectationKind(
     "energy_conserved", "total mechanical energy is conserved", needs_body=False,
-    energy_may_not_grow=True,
+    energy_may_not_grow=True, energy_conserved=True,
 ))
 NO_PENETRATION = declare_kind(ExpectationKind(
     "no_penetration", "no contact gap below zero", needs_body=False,

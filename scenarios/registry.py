@@ -59,8 +59,9 @@ def register(name: str, tags: Iterable[str], summary: str, **fixed_parameters):
             raise ValueError(f"scene {name!r} registered twice")
 
         @functools.wraps(factory)
-        def build(**parameters) -> Scene:
-            scene = factory(**{**fixed_parameters, **parameters})
+        def build(*arguments, **parameters) -> Scene:
+            bound = inspect.signature(factory).bind_partial(*arguments, **parameters)
+            scene = factory(**{**fixed_parameters, **bound.arguments})
             return dataclasses.replace(scene, name=name, tags=tags)
 
         SCENES[name] = SceneEntry(name, build, tags, summary)

@@ -90,28 +90,31 @@ def test_it_is_tabled(free_fall):
     assert "| `free_fall` | height within 1 % of the fall height" in criteria_table()
 
 
-def test_it_is_stored_and_reported(free_fall, tmp_path):
-    # Each run goes through the worker's two phases and into the store as `clearbench run`
+@pytest.mark.parametrize("bias, passed, shown", [
+    # The passing run: its verdict and its headline error, the kind's analytic error (1.5 mm
+    # off a 0.44 m fall).
+    (0.0, 1, ["data-verdict='pass'", "error 0.00333 rel."]),
+    # The drifting run (0.1 m/s upward): the kind's criterion against its figure, 30 mm off.
+    (0.1, 0, ["data-verdict='physics failed'", "error 0.0646 rel.",
+              "fails fall: height error 6.46 % &gt; 1 %"]),
+])
+def test_it_is_stored_and_reported(free_fall, tmp_path, bias, passed, shown):
+    # The run goes through the worker's two phases and into the store as `clearbench run`
     # sends it (here in this process, where the kind is registered), then into the report.
     store = ResultsStore(tmp_path / "store")
-    for bias in (0.0, 0.1):
-        spec = make_run_spec(_falling_ball(), "fake", options={"bias": bias},
-                             extra_engine_modules=FAKE)
-        request = spec.to_message() | {"trajectory_path": str(tmp_path / "run.npz")}
-        ran, scene, trajectory = run_phase(request)
-        measured = measure_phase(request, scene, trajectory)
-        store.record(RunRecord.from_worker(spec, ran, measured, revision_info(),
-                                           machine_info()),
-                     tmp_path / "run.npz", scene=spec.scene)
-        row = store.get(spec.key)
-        assert "fall.height_relative_error" in row["metrics"]
-        assert row["expectations_passed"] == (1 if bias == 0.0 else 0)
+    spec = make_run_spec(_falling_ball(), "fake", options={"bias": bias},
+                         extra_engine_modules=FAKE)
+    request = spec.to_message() | {"trajectory_path": str(tmp_path / "run.npz")}
+    ran, scene, trajectory = run_phase(request)
+    measured = measure_phase(request, scene, trajectory)
+    store.record(RunRecord.from_worker(spec, ran, measured, revision_info(), machine_info()),
+                 tmp_path / "run.npz", scene=spec.scene)
+    row = store.get(spec.key)
+    assert "fall.height_relative_error" in row["metrics"]
+    assert row["expectations_passed"] == passed
     page = write_report(store, tmp_path / "out")["html"].read_text()
-    # The scene's run shown (the last recorded, the drifting one): its verdict, its headline
-    # error (the kind's analytic error: 30 mm off a 0.44 m fall) and the kind's criterion
-    # against its figure.
-    assert "data-verdict='physics failed'" in page and "error 0.0646 rel." in page
-    assert "fails fall: height error 6.46 % &gt; 1 %" in page
+    for text in shown:
+        assert text in page, text
 
 
 def _settings(**options):

@@ -22,6 +22,7 @@ from clearbench.harness.measure.quantities import (
     E,
     FigureUnit,
     L,
+    T,
     V,
     dimension_text,
     of,
@@ -45,6 +46,9 @@ RUN_FIGURES: dict[str, FigureUnit] = {
     "solver_unconverged_steps": FigureUnit(word="steps"),
     "solver_residual_max": FigureUnit(word="engine's measure"),
     "solver_iterations_mean": FigureUnit(word="iterations"),
+    "instrument_penetration_max": L, "instrument_resolution_max": L,
+    "instrument_difference_max": L, "instrument_clearance_excess_max": L,
+    "unseen_penetration": L, "unseen_penetration_time": T,
 }
 
 def figure_unit(name: str, scene: Scene | None = None,

@@ -12,6 +12,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from clearbench.harness.measure.geometry_check import UNSEEN_PENETRATION
 from clearbench.harness.measure.headline import METRIC_LABELS, format_value, headline
 from clearbench.harness.measure.units import unit_text
 from clearbench.harness.measure.verdicts import VERDICTS, criteria, run_verdict, verdict_text
@@ -53,8 +54,19 @@ def engine_columns(labels: Sequence[str]) -> list[str]:
 def row_verdict(row) -> str:
     """The verdict of a stored run (a dict or DataFrame row): its status and its expectations
     together (:func:`~clearbench.harness.measure.verdicts.run_verdict`); the one place the
-    report asks for it."""
-    return run_verdict(row["status"], row.get("expectations_passed"))
+    report asks for it. An ok run whose stored figures hold an unseen penetration (the
+    run-wide geometry check) is "unseen penetration"."""
+    return run_verdict(row["status"], row.get("expectations_passed"),
+                       json.loads(row.get("metrics") or "{}"))
+
+
+def unseen_text(row: dict) -> str:
+    """The run-wide geometry check's finding for an "unseen penetration" run (the pair, the
+    time, the instrument's figure against the kernel's), without the verdict's name; ""
+    for any other run."""
+    if row_verdict(row) != UNSEEN_PENETRATION:
+        return ""
+    return (row.get("verdict_reason") or "").removeprefix(f"{UNSEEN_PENETRATION}: ")
 
 
 def failed_expectations(row: dict) -> list[dict]:
@@ -65,14 +77,15 @@ def failed_expectations(row: dict) -> list[dict]:
 
 def run_figure(row: dict, scene: Scene | None, c60_text: str = "") -> str:
     """What a cell shows under a run's verdict: the message of a run that did not finish;
-    ``c60_text`` (the C-60's FC-1 against the reference's and the latch, or its trip events)
-    for a C-60 run and the failed expectations' values against their limits; else the scene's
-    headline figure."""
+    the geometry check's finding for an unseen penetration; ``c60_text`` (the C-60's FC-1
+    against the reference's and the latch, or its trip events) for a C-60 run and the failed
+    expectations' values against their limits; else the scene's headline figure."""
     if row["status"] != "ok":
         return (row.get("message") or "").split("\n", 1)[0]
     failed = "; ".join(r.get("detail") or r.get("name", "") for r in failed_expectations(row))
-    if c60_text or failed:
-        return "; ".join(filter(None, [c60_text, failed]))
+    unseen = unseen_text(row)
+    if c60_text or failed or unseen:
+        return "; ".join(filter(None, [unseen, c60_text, failed]))
     figures = json.loads(row.get("metrics") or "{}")
     name, value = headline(scene, figures) if scene is not None else ("", math.nan)
     if not name:

@@ -177,7 +177,8 @@ def _run_title(row) -> str:
     """The run's message and its failed expectations (a verdict cell's title)."""
     failed = [r["name"] for r in json.loads(row.get("expectations") or "[]")
               if r.get("passed") is False]
-    return "; ".join(filter(None, [row.get("message") or "",
+    unseen = (row.get("verdict_reason") or "") if row.get("status") == "ok" else ""
+    return "; ".join(filter(None, [row.get("message") or "", unseen,
                                    f"failed: {', '.join(failed)}" if failed else ""]))
 
 

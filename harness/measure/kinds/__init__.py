@@ -2,8 +2,9 @@
 registry (:data:`~.registry.KINDS`), from which every table about kinds is read.
 
 Importing this package registers the library's kinds, grouped by what they are about:
-:mod:`.impacts`, :mod:`.friction`, :mod:`.mechanisms`, :mod:`.invariants` (energy, penetration
-and the implied energy balance) and :mod:`.outputs`.
+:mod:`.impacts`, :mod:`.friction`, :mod:`.mechanisms`, :mod:`.edges` (a body crossing the
+bound of a face), :mod:`.invariants` (energy, penetration and the implied energy checks) and
+:mod:`.outputs`.
 
 How to add a kind
 -----------------
@@ -23,6 +24,7 @@ its measuring side in a module here.
 from __future__ import annotations
 
 from clearbench.harness.measure.kinds import (  # noqa: F401  (each registers its kinds)
+    edges,
     friction,
     impacts,
     invariants,
