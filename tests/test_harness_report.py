@@ -13,7 +13,6 @@ import pytest
 
 from clearbench.harness.cli.main import main
 from clearbench.harness.measure.verdicts import VERDICTS, run_verdict
-from clearbench.harness.report import browser
 from clearbench.harness.report.figures import work_precision_figure
 from clearbench.harness.report.page import write_report
 from clearbench.harness.run.runner import Runner
@@ -174,31 +173,6 @@ def test_overview_matrix_shows_the_verdict_of_status_and_expectations(small_stor
     assert sorted(v.split(" ", 1)[1] for v in table_rows) == verdicts
 
 
-needs_chromium = pytest.mark.skipif(
-    browser.chromium() is None, reason="Debian's chromium is not installed (the Makefile's "
-    "test target installs it when run as root)")
-
-
-@needs_chromium
-def test_report_opens_in_headless_chromium(small_store, tmp_path):
-    paths = write_report(small_store, tmp_path / "out")
-    screenshot = tmp_path / "report.png"
-    # Page errors (script errors, failed resources) are logged as CONSOLE lines.
-    assert not browser.screenshot(paths["html"].as_uri(), screenshot, 1200, 1600)
-    data = screenshot.read_bytes()
-    assert data.startswith(PNG_SIGNATURE)
-    import matplotlib.image
-
-    pixels = matplotlib.image.imread(str(screenshot))
-    # A rendered page has text and coloured cells: far more than one distinct colour.
-    assert len(np.unique(pixels.reshape(-1, pixels.shape[-1]), axis=0)) > 20
-    dom, errors = browser.dump_dom(paths["html"].as_uri())
-    assert not errors
-    assert "<table" in dom and "bouncing-ball-e0.5" in dom
-    # The matrix the browser built holds, cell for cell, the verdict the store implies.
-    assert _matrix_cells(dom) == _expected_verdicts(small_store)
-
-
 def test_pareto_front_keeps_the_non_dominated_points():
     times = np.array([1.0, 2.0, 3.0, 2.5, np.nan, 4.0])
     errors = np.array([1e-1, 1e-2, 1e-3, 5e-2, 1e-9, 1e-3])
@@ -281,50 +255,6 @@ def test_report_has_the_c60_section_when_the_validation_json_exists(small_store,
     # Without the file the section is left out.
     plain = write_report(small_store, tmp_path / "plain", c60_validation=tmp_path / "none.json")
     assert "C-60: the reference" not in plain["html"].read_text()
-
-
-#: Engines of the wide store: the fake engine under six names (the demo's six engines).
-WIDE_ENGINES = {name: "tests.fake_engine"
-                for name in ("reference", "alpha", "beta", "gamma", "delta", "epsilon")}
-
-
-@pytest.fixture(scope="module")
-def wide_store(tmp_path_factory):
-    """Six engines on three scenes at their own step, two of them with a second preset on
-    one scene (two lines in a cell), one scene left out for one engine (a 'not run' cell)."""
-    store = ResultsStore(tmp_path_factory.mktemp("wide"))
-    scenes = ("bouncing-ball-e0.5", "pendulum", "clearance-pendulum")
-    specs = [make_run_spec(scene, name, horizon=0.2, extra_engine_modules=WIDE_ENGINES)
-             for scene in scenes for name in WIDE_ENGINES
-             if (scene, name) != ("pendulum", "epsilon")]
-    specs += [make_run_spec("bouncing-ball-e0.5", f"{name}[energy]", horizon=0.2,
-                            extra_engine_modules=WIDE_ENGINES) for name in ("alpha", "beta")]
-    Runner(store, jobs=2, runs_per_worker=20).run_all(specs)
-    return store
-
-
-@needs_chromium
-def test_the_page_reads_in_a_browser(wide_store, tmp_path):
-    """In headless Chromium at 1366 px: the overview matrix fits the 1,100 px column, 'not
-    run' is at most 10 % of its cells, no text block is wider than the page, every link of the
-    table of contents (and every other in-page link) resolves, no console error."""
-    from .browser_checks import report_checks
-
-    paths = write_report(wide_store, tmp_path / "out", c60_validation=None, campaigns=None)
-    checks, errors = report_checks(paths["html"], tmp_path)
-    assert not errors, errors
-    assert checks["column"] <= 1100
-    assert checks["matrix"] <= checks["column"], checks
-    assert checks["cells"] == 3 * 6
-    assert checks["notRun"] == 1 and checks["notRun"] <= 0.1 * checks["cells"]
-    assert checks["pageScroll"] <= 0 and checks["wide"] == [], checks["wide"]
-    assert checks["tocLinks"] >= 5 and checks["broken"] == []
-    page = paths["html"].read_text()
-    # Every word of a cell is in the legend: the verdicts, 'not run', the presets, the figures.
-    legend = page[page.index("<table class='legend'>"):]
-    legend = legend[:legend.index("</table>")]
-    for word in ("not run", "default", "energy", "pass"):
-        assert f">{word}<" in legend or f" {word}<" in legend, word
 
 
 #: Words of the page that are not abbreviations a reader needs explained.

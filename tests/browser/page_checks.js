@@ -1,4 +1,4 @@
-// Appended to a copy of a report page by tests/browser_page.py: measures what the browser
+// Appended to a copy of a report page by tests/browser_checks.py: measures what the browser
 // laid out and writes it as JSON into <body data-check=...> for `chromium --dump-dom`.
 (function () {
   "use strict";
@@ -9,11 +9,28 @@
     if (root.dataset.ready !== "true") return { ready: root.dataset.ready || "no" };
     const viewer = window.clearbenchViewers.find((v) => v.root === root);
     const canvas = root.querySelector("canvas");
+    const picture = () => canvas.toDataURL("image/png");
+    const start = viewer.frame;            // the frame the page opened at (?view-event=...)
     viewer.show(0);
-    const first = canvas.toDataURL("image/png");
+    const first = picture();
     viewer.show(viewer.times.length - 1);
-    const last = canvas.toDataURL("image/png");
+    const last = picture();
+    // the slider moved as a reader moves it (an input event), to the middle frame
+    const slider = root.querySelector(".cb-slider");
+    slider.value = String(Math.floor((viewer.times.length - 1) / 2));
+    slider.dispatchEvent(new Event("input"));
+    const middle = { frame: viewer.frame, differ: picture() !== first && picture() !== last };
+    // each event's button: the frame it shows and whether its picture is its own
+    const events = {};
+    const pictures = [];
+    for (const button of root.querySelectorAll(".cb-event")) {
+      button.click();
+      events[button.textContent.trim().split(" ")[0]] = viewer.times[viewer.frame];
+      pictures.push(picture());
+    }
     return { ready: "true", frames: viewer.times.length, differ: first !== last,
+             start: viewer.times[start], middle, events,
+             eventsDiffer: new Set(pictures).size === pictures.length,
              width: canvas.getBoundingClientRect().width };
   }
 
@@ -40,6 +57,8 @@
       .map((a) => a.getAttribute("href"))
       .filter((h) => !document.getElementById(decodeURIComponent(h.slice(1))));
     out.tocLinks = document.querySelectorAll("#toc a").length;
+    out.matrixCells = Object.fromEntries([...cells].map(
+      (c) => [`${c.dataset.scene}|${c.dataset.engine}`, c.dataset.verdict]));
     out.viewers = [];
     for (const root of document.querySelectorAll(".cb-viewer")) out.viewers.push(await viewerFrames(root));
     body.setAttribute("data-check", JSON.stringify(out));
