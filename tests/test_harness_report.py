@@ -301,3 +301,36 @@ def test_the_whole_page_is_readable(small_store, tmp_path):
         for cell in row:
             assert html.escape(cell) in conclusions, cell
     assert results["standing"] and html.escape(results["standing"]) in conclusions
+
+
+def test_the_legend_explains_every_registered_expectation_kind_by_its_criterion():
+    """Every kind of the expectation registry (implied ones too), failed in a cell, gets a
+    legend line with its criterion's own words: the report has no list of kinds of its own."""
+    from clearbench.harness.measure.kinds import KINDS
+    from clearbench.harness.report.overview import CellLine, words_used
+
+    for name, kind in KINDS.items():
+        line = CellLine("e[default]", "default", "physics failed", "", "", (name,))
+        used = words_used([line])
+        entry = used[f"failed: {name.replace('_', ' ')}"]
+        assert kind.criterion.passes_when in entry, name
+
+
+def test_an_unseen_penetration_is_its_own_verdict_with_its_finding():
+    """A finished run whose stored figures hold an unseen penetration (the run-wide geometry
+    check) reads "unseen penetration" in the overview, its cell giving the pair, the time and
+    the instrument's figure against the kernel's; one without it keeps its other verdict."""
+    from clearbench.harness.report.overview import cell_lines, row_verdict
+
+    reason = ("unseen penetration: ball_floor at t = 0.1 s: the instrument witnesses 0.002 m, "
+              "the kernel's figure is 0 m")
+    row = {"status": "ok", "expectations_passed": 1, "message": "", "expectations": "[]",
+           "metrics": json.dumps({"unseen_penetration": 0.002}), "verdict_reason": reason}
+    assert row_verdict(row) == "unseen penetration"
+    (line,) = cell_lines({"e[default]": row}, "e", None)
+    assert line.verdict == "unseen penetration"
+    assert line.figure.startswith("ball_floor at t = 0.1 s: the instrument witnesses 0.002 m")
+    seen = {**row, "metrics": json.dumps({"unseen_penetration": 0.0}), "verdict_reason": ""}
+    assert row_verdict(seen) == "pass"
+    # a run that did not finish keeps its status's verdict whatever its figures
+    assert row_verdict({**row, "status": "diverged"}) == "diverged"
