@@ -10,6 +10,7 @@ named in the address: tests/test_report_viewer.py, on the page `clearbench view`
 
 from __future__ import annotations
 
+import fcntl
 import hashlib
 import html
 import json
@@ -44,8 +45,8 @@ UNSEEN_REASON = ("unseen penetration: ball_floor at t = 0.1 s: the instrument wi
 TRIP_SAMPLES = 171
 
 
-def _flag_unseen(store: ResultsStore, folder) -> str:
-    """Give the UNSEEN_RUN run the figures of an unseen penetration; its key."""
+def _flag_unseen(store: ResultsStore, folder) -> None:
+    """Give the UNSEEN_RUN run the figures of an unseen penetration."""
     frame = store.dataframe(expand_metrics=False)
     scene, engine = UNSEEN_RUN
     key = frame[(frame["scene_name"] == scene) & (frame["label"] == f"{engine}[default]")][
@@ -58,7 +59,6 @@ def _flag_unseen(store: ResultsStore, folder) -> str:
     kept = folder / "unseen.npz"
     shutil.copy(store.trajectory_path(key), kept)   # record() moves the file into the store
     store.record(RunRecord(**{c: row[c] for c in COLUMNS}), kept, replace=True)
-    return key
 
 
 def _record_c60_trip(store: ResultsStore, folder) -> None:
@@ -83,21 +83,41 @@ def _record_c60_trip(store: ResultsStore, folder) -> None:
         store.record(RunRecord(**{c: row[c] for c in COLUMNS}), path, scene=spec.scene)
 
 
-@pytest.fixture(scope="module")
-def report(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("browser-report")
+def _build(folder) -> None:
+    """The store, the report and page_checks.js's measurements (checks.json) in ``folder``."""
     store = ResultsStore(folder / "store")
     specs = [make_run_spec(scene, name, horizon=0.2, extra_engine_modules=ENGINES)
              for scene in LIBRARY for name in ENGINES if (scene, name) != ("pendulum", "epsilon")]
     specs += [make_run_spec("bouncing-ball-e0.5", f"{name}[energy]", horizon=0.2,
                             extra_engine_modules=ENGINES) for name in ("alpha", "beta")]
     Runner(store, jobs=2, runs_per_worker=20).run_all(specs)
-    unseen = _flag_unseen(store, folder)
+    _flag_unseen(store, folder)
     _record_c60_trip(store, folder)
     paths = write_report(store, folder / "out", c60_validation=None, campaigns=None)
     checks, errors = report_checks(paths["html"], folder)
-    return SimpleNamespace(store=store, paths=paths, checks=checks, errors=errors,
-                           page=paths["html"].read_text(encoding="utf-8"), unseen=unseen)
+    (folder / "checks.json").write_text(json.dumps({"checks": checks, "errors": errors}))
+
+
+@pytest.fixture(scope="module")
+def report(tmp_path_factory, worker_id):
+    """The report built and measured once per test session: pytest-xdist's workers share the
+    first one's (its documented pattern: a folder beside the workers' own, under a lock), so
+    a module split between workers does not build it twice."""
+    root = tmp_path_factory.getbasetemp()
+    if worker_id != "master":
+        root = root.parent
+    folder = root / "report-browser"
+    with open(root / "report-browser.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)      # released when the file closes
+        if not (folder / "checks.json").exists():
+            shutil.rmtree(folder, ignore_errors=True)
+            folder.mkdir()
+            _build(folder)
+    measured = json.loads((folder / "checks.json").read_text())
+    page = folder / "out" / "report.html"
+    return SimpleNamespace(store=ResultsStore(folder / "store"), html=page,
+                           checks=measured["checks"], errors=measured["errors"],
+                           page=page.read_text(encoding="utf-8"))
 
 
 def test_the_page_logs_no_console_message(report):
@@ -181,6 +201,11 @@ def test_every_cell_shows_the_verdict_the_store_implies(report):
     finding = UNSEEN_REASON.removeprefix("unseen penetration: ")
     overview = report.page[report.page.index("id='overview-matrix'"):]
     assert html.escape(finding) in overview[:overview.index("</table>")]
+    # and the conclusions count it among gamma's library verdicts
+    conclusions = report.page[report.page.index("<h2 id='conclusions'>"):
+                              report.page.index("<h2 id='overview'>")]
+    gamma = conclusions[conclusions.index("gamma[default]"):]
+    assert "1 unseen penetration" in gamma[:gamma.index("</tr>")]
 
 
 def test_the_synthetic_runs_are_what_the_page_shows(report):
