@@ -28,7 +28,7 @@ from clearbench.harness.c60.cross_engine import collect
 from clearbench.harness.c60.runs import DEFAULT_TIMEOUT as STUDY_TIMEOUT
 from clearbench.harness.c60.runs import StudyRuns
 from clearbench.harness.c60.validation import validate, write_figures, write_json, write_markdown
-from clearbench.harness.c60.work_precision import steps_for_target, work_precision
+from clearbench.harness.c60.work_precision import BUDGETS, error_budget, work_precision
 from clearbench.harness.cli.commands import command_help
 from clearbench.harness.cli.common import (
     UserError,
@@ -80,8 +80,9 @@ def register(subparsers) -> None:
         "compare", help="c60-on and c60-trip across engines, work-precision, report",
         description="Run c60-on and c60-trip in every available engine and preset of the "
         "plan over its ladder of steps (runs already in the store are reused), print the "
-        "cross-engine figures (FC-1, latch creep, trip times, penetration, wall time) and the "
-        "step each engine needs for 1 % on FC-1, and write the report. Plan `demo` (what "
+        "cross-engine figures (FC-1, latch creep, trip times, penetration, wall time) and each "
+        "engine's cheapest step within an error budget of 1 % and 5 % (its error and every "
+        "finer step's), and write the report. Plan `demo` (what "
         "`clearbench demo` runs: shortened horizons, a few minutes of CPU) or `full` (the "
         "scenes' horizons and longer ladders: hours).",
     )
@@ -238,8 +239,8 @@ def run_c60_plan(plan_name: str, labels, modules, args, store) -> set[str]:
 
 
 def print_c60(store, keys: set[str]) -> None:
-    """The cross-engine figures of the runs ``keys`` and the step each engine needs for 1 %
-    on FC-1."""
+    """The cross-engine figures of the runs ``keys`` and each engine's cheapest step within
+    each error budget (:data:`BUDGETS`)."""
     frame = store.dataframe(expand_metrics=False)
     runs = collect(store, frame[frame["key"].isin(keys)])
     print(f"\n  {'scene':<9} {'engine':<20} {'dt [ms]':>8} {'status':<10} {'FC-1 [N]':>9} "
@@ -257,9 +258,11 @@ def print_c60(store, keys: set[str]) -> None:
               f"{format_value(run.ratio_to_reference):>6}")
     for study in work_precision(runs):
         print(f"\n  {study.quantity}: reference {study.reference_value:.5g} at dt = "
-              f"{study.reference_step:g} ms (horizon {study.horizon:g} ms); error <= 1 %:")
-        for entry in steps_for_target(study):
-            print(f"    {entry.label:<22} {entry.describe()}")
+              f"{study.reference_step:g} ms (horizon {study.horizon:g} ms); the cheapest step "
+              "whose error and every finer step's stay within the budget:")
+        for budget in BUDGETS:
+            for entry in error_budget(runs, study, budget):
+                print(f"    {entry.label:<22} {entry.describe()}")
 
 
 def run_c60_compare(args: argparse.Namespace) -> int:

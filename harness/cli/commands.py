@@ -38,6 +38,8 @@ COMMANDS: dict[str, Command] = {
                          "engine"),
     "report": Command("report", "write the HTML report and Markdown summary from a results "
                       "store"),
+    "view": Command("view", "play stored runs of a scene side by side in the browser (a "
+                    "self-contained page)"),
     "regress": Command("regress", "compare a quick suite with the committed baseline"),
     "fclib": Command("fclib", "validate the contact solvers on FCLIB problems (side by side "
                      "with Siconos)"),

@@ -1,15 +1,16 @@
-"""The report's C-60 section across engines: for ``c60-on`` and ``c60-trip``, one row per
-engine, preset and step with its status, functional conditions, latch creep, trip times,
-largest penetration and clearance excess per joint, wall time and ratio to the reference; the
-engines that could not run it with their reason; the work-precision figure and the step each
-engine needs for 1 % on FC-1. Figures come from :mod:`clearbench.harness.c60.cross_engine`
-(one implementation for every engine). Units: mm, ms, N; wall times in s.
+"""The report's C-60 section across engines: the labelled schematic, the viewer (c60-trip's
+runs side by side), every engine's hook angle, bar angle, C7 gap and FC-1 against time; for
+``c60-on`` and ``c60-trip``, one row per engine, preset and step with its status, functional
+conditions, latch creep, each trip event against the reference's, largest penetration and
+clearance excess per joint, wall time and ratio to the reference; the engines that could not
+run it with their reason; the work-precision figure and the error-budget table. Figures come
+from :mod:`clearbench.harness.c60.cross_engine` (one implementation for every engine).
+Units: mm, ms, N; wall times in s.
 """
 
 from __future__ import annotations
 
-import base64
-import html
+import logging
 import math
 from dataclasses import dataclass, field
 
@@ -23,30 +24,48 @@ from clearbench.harness.c60.cross_engine import (
     collect,
 )
 from clearbench.harness.c60.work_precision import (
-    FC1_TARGET,
-    StepForTarget,
+    BUDGETS,
+    BudgetStep,
     WorkPrecision,
-    steps_for_target,
+    error_budget,
     work_precision,
 )
 from clearbench.harness.measure.headline import format_value
+from clearbench.harness.report import c60_motion
 from clearbench.harness.report.figures import c60_work_precision_figure
+from clearbench.harness.report.html_parts import esc as _esc
+from clearbench.harness.report.html_parts import heading, length_text, png_figure, table
+from clearbench.harness.report.schematic import schematic_figure
+from clearbench.harness.report.viewer.payload import viewer_fragment, viewer_payload
+
+LOG = logging.getLogger(__name__)
 
 FIGURE_TITLE = "C-60 work-precision"
 FIGURE_CAPTION = ("Error of FC-1 (c60-on) and of the opening time (c60-trip) against the "
                   "reference at its finest step, over stepping wall time per run; one colour "
-                  "and marker per engine, labels are steps [ms], circles the Pareto front (the "
-                  "reference's fine run is the zero of the error, not drawn). Look for the "
-                  "points below the dotted 1 % line and how far right they sit.")
+                  "and marker per engine, labels are steps [ms], circles the Pareto front of "
+                  "the runs that finished (the reference's fine run is the zero of the error, "
+                  "not drawn). Look for the points below the dotted 1 % line and how far right "
+                  "they sit.")
+#: A trip event more than this far (relative, of the reference's time from t = 0) from the
+#: reference's is flagged: the events are 0.7-3.7 ms apart and recorded every 0.01 ms, so 5 %
+#: of 3-8 ms (0.15-0.4 ms, 15-40 samples) is far beyond the sampling and still well inside
+#: the gaps between events.
+EVENT_BOUND = 0.05
+#: The flag beside an event beyond EVENT_BOUND.
+FLAG = "\u2691"
 
 
 @dataclass
 class C60Section:
     runs: list                                   # C60RunFigures
     studies: list                                # WorkPrecision
-    targets: dict = field(default_factory=dict)  # quantity -> [StepForTarget]
+    budgets: list = field(default_factory=list)  # BudgetStep, every quantity and budget
     cannot_run: dict = field(default_factory=dict)   # label -> reason
-    figure: bytes | None = None
+    figure: bytes | None = None                  # work-precision
+    schematic: bytes | None = None               # the labelled schematic (PNG)
+    series: dict = field(default_factory=dict)   # scene name -> time-series PNG
+    viewer: dict | None = None                   # the viewer's payload (c60-trip's runs)
 
     @property
     def empty(self) -> bool:
@@ -56,7 +75,8 @@ class C60Section:
 def build_section(store, frame, figures: bool = True, colours=None) -> C60Section:
     """The section's content from a store and its DataFrame (``frame``): empty when the
     store holds no run of c60-on or c60-trip. ``colours``: engine name -> declared colour
-    (:func:`.engine_style.engine_colours`)."""
+    (:func:`.engine_style.engine_colours`). With ``figures``: the work-precision figure, the
+    labelled schematic, each scene's time series and the viewer of c60-trip (else c60-on)."""
     runs = collect(store, frame)
     if not runs:   # no C-60 run in the store: no section
         return C60Section([], [])
@@ -64,35 +84,97 @@ def build_section(store, frame, figures: bool = True, colours=None) -> C60Sectio
     cannot = {f"{a.engine}": f"not available here: {a.detail}" for a in all_availability()
               if not a.available}
     cannot.update(capability_reasons(frame))
-    section = C60Section(runs, studies,
-                         {s.quantity: steps_for_target(s) for s in studies if s.points},
-                         cannot)
-    if figures and studies:
-        section.figure = c60_work_precision_figure(studies, colours)
+    budgets = [step for study in studies if study.points or study.reference_value
+               for budget in BUDGETS for step in error_budget(runs, study, budget)]
+    section = C60Section(runs, studies, budgets, cannot)
+    if figures:
+        _draw(section, store, colours)
     return section
 
 
+def _draw(section: C60Section, store, colours) -> None:
+    """The section's figures and viewer (a figure that fails is left out, with a warning:
+    a figure must never stop the report)."""
+    if section.studies:
+        section.figure = c60_work_precision_figure(section.studies, colours)
+    for scene_name in (TRIP_SCENE, ON_SCENE):
+        shown = c60_motion.shown_runs(store, section.runs, scene_name)
+        if not shown:
+            continue
+        scene = store.scene(store.get(shown[0].figures.key)["scene_hash"])
+        try:
+            image = c60_motion.time_series_figure(scene, shown, colours)
+            if image is not None:
+                section.series[scene_name] = image
+            if section.schematic is None:
+                section.schematic = schematic_figure(scene)
+            if section.viewer is None:
+                section.viewer = viewer_payload(scene, c60_motion.recorded_runs(shown),
+                                                c60_motion.reference_events(shown))
+        except Exception as error:  # noqa: BLE001 - reported, the report goes on
+            LOG.warning("C-60 motion figures of %s not drawn: %s", scene_name, error)
+
+
 # ---------------------------------------------------------------------------- cells
-def _esc(value) -> str:
-    return html.escape(str(value))
-
-
 def _ms(value: float) -> str:
     return "—" if not math.isfinite(value) else f"{value:.3f}"
 
 
-def _difference(value: float, reference: float) -> str:
+def relative(value: float, reference: float) -> float:
+    """(value - reference) / |reference|; NaN when either is missing."""
     if not (math.isfinite(value) and math.isfinite(reference) and reference):
-        return ""
-    return f" ({100 * (value - reference) / abs(reference):+.3g} %)"
+        return math.nan
+    return (value - reference) / abs(reference)
 
 
-def _reference_value(runs, scene_name: str, horizon: float, attribute: str) -> float:
+def _difference(value: float, reference: float) -> str:
+    change = relative(value, reference)
+    return "" if math.isnan(change) else f" ({100 * change:+.3g} %)"
+
+
+def reference_run(runs, scene_name: str, horizon: float) -> C60RunFigures | None:
+    """The reference's finest finished run of the scene at ``horizon`` (the yardstick)."""
     candidates = [r for r in runs if r.scene_name == scene_name and r.label == REFERENCE_LABEL
                   and r.horizon == horizon and r.status == "ok"]
-    if not candidates:
-        return math.nan
-    return getattr(min(candidates, key=lambda r: r.time_step), attribute)
+    return min(candidates, key=lambda r: r.time_step) if candidates else None
+
+
+@dataclass(frozen=True)
+class EventComparison:
+    """One trip event of a run against the reference's: times [ms], relative difference of
+    the times from t = 0 (NaN when either is missing), and whether it is beyond
+    :data:`EVENT_BOUND` (an event the run has and the reference not, or the other way round,
+    is flagged too)."""
+
+    event: str
+    time: float
+    reference: float
+    change: float
+    flagged: bool
+
+    def text(self) -> str:
+        if not math.isfinite(self.time):
+            return "none" + (f" {FLAG}" if self.flagged else "")
+        change = "" if math.isnan(self.change) else f" ({100 * self.change:+.3g} %)"
+        return f"{self.time:.3f}{change}" + (f" {FLAG}" if self.flagged else "")
+
+
+def compare_events(run: C60RunFigures, reference: C60RunFigures | None
+                   ) -> list[EventComparison]:
+    """Each trip event (strike, release, opening) of ``run`` against the reference's (not
+    compared when ``run`` is the reference's run itself)."""
+    if reference is not None and reference.key == run.key:
+        reference = None
+    out = []
+    for event in c60_motion.EVENTS:
+        time = getattr(run, event)
+        ref = getattr(reference, event) if reference is not None else math.nan
+        change = relative(time, ref)
+        missing_one = reference is not None and math.isfinite(ref) != math.isfinite(time)
+        flagged = (not math.isnan(change) and abs(change) > EVENT_BOUND) or (
+            missing_one and run.status == "ok")
+        out.append(EventComparison(event, time, ref, change, flagged))
+    return out
 
 
 def _status(run: C60RunFigures) -> str:
@@ -103,19 +185,26 @@ def _status(run: C60RunFigures) -> str:
     return text
 
 
-def _latch(run: C60RunFigures) -> str:
+def latch_text(run: C60RunFigures) -> str:
+    """``holds, creep 0.0012 µm`` / ``SLIPS, creep 1.64 mm``: the latch's state and the hook's
+    creep."""
     if run.latched is None:
-        return "—" if math.isnan(run.latch_creep) else format_value(run.latch_creep)
-    return f"{'holds' if run.latched else 'SLIPS'}, {format_value(run.latch_creep)}"
+        return "—" if math.isnan(run.latch_creep) else length(run.latch_creep)
+    return f"{'holds' if run.latched else 'SLIPS'}, creep {length(run.latch_creep)}"
+
+
+def length(value: float, unit: str = "mm") -> str:
+    """A C-60 length (given in mm), as :func:`.html_parts.length_text` writes it."""
+    return length_text(value, unit)
 
 
 def _joints(run: C60RunFigures) -> tuple[str, str]:
-    """(worst joint text, every joint's excess) [mm]."""
+    """(worst joint text, every joint's excess)."""
     name, worst = run.worst_joint
     if not name:
         return "—", ""
-    detail = ", ".join(f"{j} {format_value(v)}" for j, v in run.clearance_excess.items())
-    return f"{name} {format_value(worst)}", detail
+    detail = ", ".join(f"{j} {length(v)}" for j, v in run.clearance_excess.items())
+    return f"{name} {length(worst)}", detail
 
 
 def _head_cells(run: C60RunFigures) -> list[str]:
@@ -124,10 +213,10 @@ def _head_cells(run: C60RunFigures) -> list[str]:
 
 
 def _instrument(run: C60RunFigures) -> str:
-    """The independent instrument's largest penetration [mm], and its unseen excess."""
-    text = format_value(run.instrument_penetration)
+    """The independent instrument's largest penetration, and its unseen excess."""
+    text = length(run.instrument_penetration)
     if run.unseen_penetration > 0:
-        text += (f" UNSEEN {format_value(run.unseen_penetration)} more than the kernel's at "
+        text += (f" UNSEEN {length(run.unseen_penetration)} more than the kernel's at "
                  f"{run.unseen_time:.4g} ms")
     return text
 
@@ -137,53 +226,92 @@ def _tail_cells(run: C60RunFigures) -> list[str]:
     joint, wall per step [ms] and per run [s], x reference."""
     if run.status == "unsupported":
         return ["—"] * 7
-    return [f"{format_value(run.penetration_max)} {run.penetration_pair}".strip(),
-            _instrument(run), format_value(run.penetration_beyond_rebuild), _joints(run)[0],
+    return [f"{length(run.penetration_max)} {run.penetration_pair}".strip(),
+            _instrument(run), length(run.penetration_beyond_rebuild), _joints(run)[0],
             format_value(1e3 * run.stepping_seconds_per_step), format_value(run.stepping_seconds),
             format_value(run.ratio_to_reference)]
+
+
+def table_runs(runs, scene_name: str) -> list[C60RunFigures]:
+    """The runs of one scene in the order of its table: the reference first, then by engine
+    label and step."""
+    return sorted((r for r in runs if r.scene_name == scene_name),
+                  key=lambda r: (r.label != REFERENCE_LABEL, r.label, r.time_step))
 
 
 def on_rows(runs) -> list[list[str]]:
     """Cells of the c60-on table (plain text)."""
     rows = []
-    for run in (r for r in runs if r.scene_name == ON_SCENE):
-        fc1_ref = _reference_value(runs, ON_SCENE, run.horizon, "fc1")
+    for run in table_runs(runs, ON_SCENE):
+        reference = reference_run(runs, ON_SCENE, run.horizon)
+        fc1_ref = reference.fc1 if reference is not None and reference.key != run.key \
+            else math.nan
         others = ", ".join(f"{k} {format_value(v)}" for k, v in run.functional_conditions.items()
                            if k != "FC-1")
         rows.append(_head_cells(run) + [format_value(run.fc1) + _difference(run.fc1, fc1_ref),
-                                        others or "—", _latch(run)] + _tail_cells(run))
+                                        others or "—", latch_text(run)] + _tail_cells(run))
     return rows
 
 
 def trip_rows(runs) -> list[list[str]]:
-    """Cells of the c60-trip table (plain text)."""
+    """Cells of the c60-trip table (plain text): each event against the reference's."""
     rows = []
-    for run in (r for r in runs if r.scene_name == TRIP_SCENE):
-        opening_ref = _reference_value(runs, TRIP_SCENE, run.horizon, "opening")
-        rows.append(_head_cells(run) + [
-            _ms(run.strike), _ms(run.release),
-            _ms(run.opening) + _difference(run.opening, opening_ref)] + _tail_cells(run))
+    for run in table_runs(runs, TRIP_SCENE):
+        reference = reference_run(runs, TRIP_SCENE, run.horizon)
+        events = [c.text() for c in compare_events(run, reference)]
+        rows.append(_head_cells(run) + events + _tail_cells(run))
     return rows
 
 
 ON_HEAD = ["engine", "dt [ms]", "horizon [ms]", "status", "FC-1 [N] (vs reference)",
-           "FC-2..FC-6 [mm]", "latch (hook creep after 3 ms) [mm]", "largest penetration [mm]",
-           "independent instrument [mm]", "beyond the rebuild's overlap [mm]",
-           "worst joint: clearance excess [mm]",
-           "wall / step [ms]", "wall / run [s]", "x reference"]
-TRIP_HEAD = ["engine", "dt [ms]", "horizon [ms]", "status", "strike [ms]", "latch release [ms]",
-             "contacts open [ms] (vs reference)", "largest penetration [mm]",
-             "independent instrument [mm]", "beyond the rebuild's overlap [mm]",
-           "worst joint: clearance excess [mm]",
-             "wall / step [ms]", "wall / run [s]", "x reference"]
+           "FC-2..FC-6 [mm]", "latch (hook creep after 3 ms)", "largest penetration",
+           "independent instrument", "beyond the rebuild's overlap",
+           "worst joint: clearance excess", "wall / step [ms]", "wall / run [s]", "x reference"]
+TRIP_HEAD = ["engine", "dt [ms]", "horizon [ms]", "status", "strike [ms] (vs reference)",
+             "latch release [ms] (vs reference)", "contacts open [ms] (vs reference)",
+             "largest penetration", "independent instrument", "beyond the rebuild's overlap",
+             "worst joint: clearance excess", "wall / step [ms]", "wall / run [s]",
+             "x reference"]
 
 
-def target_lines(section: C60Section) -> list[str]:
-    lines = []
-    for quantity, entries in section.targets.items():
-        for entry in entries:
-            lines.append(f"{entry.label}, {quantity}: {entry.describe()}")
-    return lines
+def run_summary(section: C60Section, run: C60RunFigures) -> str:
+    """What a finished C-60 run comes to, against the reference's finest run (none for that
+    run itself): c60-on's FC-1 and the latch, c60-trip's events."""
+    reference = reference_run(section.runs, run.scene_name, run.horizon)
+    if reference is not None and reference.key == run.key:
+        reference = None     # the yardstick itself: nothing to compare with
+    if run.scene_name == ON_SCENE:
+        change = relative(run.fc1, reference.fc1) if reference else math.nan
+        versus = "" if math.isnan(change) else f" ({100 * change:+.2g} %)"
+        return f"FC-1 {format_value(run.fc1, 'N')}{versus}, latch {latch_text(run)}"
+    return ", ".join(f"{c.event} {c.text()}" for c in compare_events(run, reference))
+
+
+def c60_cell_texts(section: C60Section) -> dict[str, str]:
+    """Run key -> what the overview's cell shows for a finished C-60 run
+    (:func:`run_summary`)."""
+    return {run.key: run_summary(section, run) for run in section.runs if run.status == "ok"}
+
+
+def _budget_cell(step: BudgetStep | None) -> str:
+    if step is None:
+        return "not run"
+    if step.time_step is None:
+        return f"not met: {step.reason}"
+    return (f"dt {step.time_step:g} ms: {100 * step.error:.2g} %, "
+            f"{format_value(step.wall_seconds)} s per run")
+
+
+def budget_table(section: C60Section) -> tuple[list[str], list[list[str]]]:
+    """(head, rows) of the error-budget table: one row per engine label, one column per
+    quantity and budget."""
+    columns = [(study.quantity, budget) for study in section.studies for budget in BUDGETS]
+    labels = sorted({s.label for s in section.budgets}, key=lambda x: (x != REFERENCE_LABEL, x))
+    by_key = {(s.label, s.quantity, s.budget): s for s in section.budgets}
+    head = ["engine"] + [f"{q} within {100 * b:g} %" for q, b in columns]
+    rows = [[label] + [_budget_cell(by_key.get((label, q, b))) for q, b in columns]
+            for label in labels]
+    return head, rows
 
 
 def condense(reason: str) -> str:
@@ -233,55 +361,99 @@ INTRO = ("Each engine and preset on the C-60 scenes, measured by the same code "
          "stepping alone on a shared machine; 'x reference' is the ratio of wall time per "
          "simulated ms to the reference engine's fine run (its finest step), the run every "
          "error is measured against.")
+TRIP_NOTE = ("Each event's time against the reference's finest run, relative to the "
+             "reference's time from t = 0; " + FLAG + f" beyond {100 * EVENT_BOUND:g} % (or an "
+             "event one run has and the other not); 'none': did not happen within the run. "
+             "Strike: the plunger first pushes the tripping bar; release: the latch contacts "
+             "C4 and C5 first carry no force; opening: C7's gap first exceeds 0.1 mm.")
+BUDGET_NOTE = ("For each error budget, the cheapest step of the engine's ladder whose error "
+               "and the error of every finer step of the ladder stay within it (a finer step "
+               "that diverged or drifts beyond it disqualifies the coarser ones), with that "
+               "step's error and the run's stepping wall time. The reference's finest step is "
+               "the yardstick (error 0).")
+MOTION_CAPTION = ("Each engine's finest run of c60-trip played side by side: drag to turn "
+                  "the view (every view follows), the slider or play to move in time, the "
+                  "event buttons for the pose at the reference's strike, release and opening. "
+                  "Bodies are drawn from the scene's contact primitives (rings, faces, "
+                  "cylinders: the C-60's CAD surfaces, not its whole parts); black dots are "
+                  "contacts that carry force and red lines their forces on the second body of "
+                  "each pair, to one scale in every view.")
+SCHEMATIC_CAPTION = ("The C-60 in its ON pose seen along z: each part in its colour (the "
+                     "viewer's), the revolute joints J1..J7 (and the needle's bearing S3) at "
+                     "their rings, the contacts C1..C7 at their contact points.")
+SERIES_CAPTION = ("Every engine's finest run against time: the hook's and the tripping bar's "
+                  "rotation about z since t = 0, C7's gap (moving on fixed contact; c60-trip) "
+                  "and FC-1, C7's normal force. Markers: strike (triangle), release (circle), "
+                  "opening (square). The y range holds the runs that finished; a run that "
+                  "diverged leaves it ('off scale' in the legend).")
 
 
 # ---------------------------------------------------------------------------- HTML
-def _table_html(head: list[str], rows: list[list[str]], runs, scene_name: str) -> str:
+def _table_html(head: list[str], rows: list[list[str]], runs, scene_name: str,
+                caption: str) -> str:
     """The table with the status's message as its tooltip and each joint's excess folded."""
-    mine = [r for r in runs if r.scene_name == scene_name]
+    mine = table_runs(runs, scene_name)
     status_column, joint_column = head.index("status"), len(head) - 4
     body = []
     for cells, run in zip(rows, mine, strict=True):
         tds = []
         for index, cell in enumerate(cells):
             if index == status_column:
-                tds.append(f"<td title='{_esc(run.message)}'>{_esc(cell)}</td>")
+                tds.append(f"<span title='{_esc(run.message)}'>{_esc(cell)}</span>")
             elif index == joint_column and _joints(run)[1]:
-                tds.append(f"<td><details><summary>{_esc(cell)}</summary><span "
-                           f"class='small'>{_esc(_joints(run)[1])}</span></details></td>")
+                tds.append(f"<details><summary>{_esc(cell)}</summary><span "
+                           f"class='small'>{_esc(_joints(run)[1])}</span></details>")
             else:
-                tds.append(f"<td>{_esc(cell)}</td>")
-        body.append(f"<tr>{''.join(tds)}</tr>")
-    header = "".join(f"<th>{_esc(h)}</th>" for h in head)
-    return f"<table><tr>{header}</tr>{''.join(body)}</table>"
+                tds.append(_esc(cell))
+        body.append(tds)
+    numeric = (1, 2, len(head) - 3, len(head) - 2, len(head) - 1)
+    return table(head, body, caption, raw=True, css_class="wide", numeric=numeric)
+
+
+def motion_html(section: C60Section) -> str:
+    """The schematic, the viewer and the time series (the C-60 seen moving)."""
+    parts = []
+    if section.schematic is not None:
+        parts.append(png_figure(section.schematic, SCHEMATIC_CAPTION,
+                                "C-60 schematic: parts, joints J1..J7, contacts C1..C7"))
+    if section.viewer is not None:
+        parts.append(viewer_fragment(section.viewer, "c60-viewer", MOTION_CAPTION))
+    for scene_name, png in section.series.items():
+        parts.append(png_figure(png, f"{scene_name}: {SERIES_CAPTION}"))
+    if not parts:
+        return ""
+    return heading(3, "The C-60 seen moving", "c60-motion") + "".join(parts)
 
 
 def section_html(section: C60Section) -> str:
     if section.empty:
         return ""
-    parts = ["<h2 id='c60-engines'>C-60 across engines</h2>",
-             f"<p class='small'>{_esc(INTRO)} Runs: {_esc(_horizons(section.runs))}.</p>"]
+    parts = [heading(2, "C-60 across engines", "c60-engines"),
+             f"<p class='small'>{_esc(INTRO)} Runs: {_esc(_horizons(section.runs))}.</p>",
+             motion_html(section)]
     if any(r.scene_name == ON_SCENE for r in section.runs):
-        parts += ["<h3>c60-on: settled ON pose</h3>",
+        parts += [heading(3, "c60-on: settled ON pose", "c60-on-table"),
                   "<p class='small'>Look for: FC-1 near the reference's, the latch holding, "
-                  "penetration and clearance excess far below the 0.006-0.04 mm clearances."
-                  "</p>", _table_html(ON_HEAD, on_rows(section.runs), section.runs, ON_SCENE)]
+                  "penetration and clearance excess far below the 6-40 µm clearances.</p>",
+                  _table_html(ON_HEAD, on_rows(section.runs), section.runs, ON_SCENE,
+                              "c60-on: one row per engine, preset and step")]
     if any(r.scene_name == TRIP_SCENE for r in section.runs):
-        parts += ["<h3>c60-trip: magnetic trip</h3>",
-                  "<p class='small'>Look for: the three events in order and near the "
-                  "reference's times ('—': did not happen within the run).</p>",
-                  _table_html(TRIP_HEAD, trip_rows(section.runs), section.runs, TRIP_SCENE)]
+        parts += [heading(3, "c60-trip: magnetic trip", "c60-trip-table"),
+                  f"<p class='small'>{_esc(TRIP_NOTE)}</p>",
+                  _table_html(TRIP_HEAD, trip_rows(section.runs), section.runs, TRIP_SCENE,
+                              "c60-trip: each event against the reference's")]
+    if section.budgets:
+        head, rows = budget_table(section)
+        parts += [heading(3, "Error budget: the step each engine needs", "c60-error-budget"),
+                  f"<p class='small'>{_esc(BUDGET_NOTE)}</p>",
+                  table(head, rows, "The cheapest step within 1 % and 5 %, per engine")]
+    if section.figure is not None:
+        parts.append(png_figure(section.figure, FIGURE_CAPTION, FIGURE_TITLE))
     if section.cannot_run:
         items = "".join(f"<li><b>{_esc(k)}</b>: {_esc(condense(v))}</li>"
                         for k, v in sorted(section.cannot_run.items()))
-        parts.append(f"<h3>Engines that cannot run the C-60 here</h3><ul>{items}</ul>")
-    if section.targets:
-        items = "".join(f"<li>{_esc(line)}</li>" for line in target_lines(section))
-        parts.append(f"<h3>Step needed for {100 * FC1_TARGET:g} %</h3><ul>{items}</ul>")
-    if section.figure is not None:
-        parts.append(f"<figure><img alt='{FIGURE_TITLE}' src='data:image/png;base64,"
-                     f"{base64.b64encode(section.figure).decode()}'>"
-                     f"<figcaption class='small'>{_esc(FIGURE_CAPTION)}</figcaption></figure>")
+        parts += [heading(3, "Engines that cannot run the C-60 here", "c60-cannot-run"),
+                  f"<ul class='small'>{items}</ul>"]
     problems = _problems(section.runs)
     if problems:
         items = "".join(f"<li>{_esc(p)}</li>" for p in problems)
@@ -307,18 +479,19 @@ def section_markdown(section: C60Section, figure_file: str | None = None) -> lis
     if any(r.scene_name == ON_SCENE for r in section.runs):
         lines += ["### c60-on", ""] + _table_markdown(ON_HEAD, on_rows(section.runs))
     if any(r.scene_name == TRIP_SCENE for r in section.runs):
-        lines += ["### c60-trip", ""] + _table_markdown(TRIP_HEAD, trip_rows(section.runs))
+        lines += ["### c60-trip", "", TRIP_NOTE, ""] + _table_markdown(
+            TRIP_HEAD, trip_rows(section.runs))
+    if section.budgets:
+        head, rows = budget_table(section)
+        lines += ["### Error budget", "", BUDGET_NOTE, ""] + _table_markdown(head, rows)
     if section.cannot_run:
         lines += ["Engines that cannot run the C-60 here:", ""]
         lines += [f"- {k}: {_md(condense(v))}"
                   for k, v in sorted(section.cannot_run.items())] + [""]
-    if section.targets:
-        lines += [f"Step needed for {100 * FC1_TARGET:g} %:", ""]
-        lines += [f"- {_md(line)}" for line in target_lines(section)] + [""]
     if figure_file:
         lines += [f"![{FIGURE_TITLE}]({figure_file})", "", f"*{FIGURE_CAPTION}*", ""]
     return lines
 
 
-__all__ = ["C60Section", "StepForTarget", "WorkPrecision", "build_section", "section_html",
+__all__ = ["C60Section", "BudgetStep", "WorkPrecision", "build_section", "section_html",
            "section_markdown"]

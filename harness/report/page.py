@@ -1,23 +1,26 @@
 """The comparison report: a self-contained HTML page and a Markdown summary from a results store.
 
-Contents, the tables a reader looks at first: an overview matrix (scene x engine: verdict and
-headline metric), the stiff and extreme suite in the same form, the C-60 across engines
-(:mod:`.c60_section`: c60-on and c60-trip per engine, work-precision) and, when ``clearbench
-c60 validate`` has written its JSON, the C-60 table against the paper and its
-force-displacement figures; then the detail: per scene a table of every run with its metrics, the
-work–precision plot with its Pareto front and drift and creep over time, and per engine the
-features it approximates or does not support (from ``Engine.capabilities``, recorded with each
-run; each once per engine and feature, the detail folded). Figures are embedded as base64 PNG
-in the HTML and written as PNG files beside the Markdown.
+Contents, in the order a mechanism engineer reads them: a table of contents; the conclusions
+(:mod:`.conclusions`: one line per engine and preset, and the C-60 model's standing against the
+paper); the overview matrix (:mod:`.overview`: scene x engine, each preset a line in its
+engine's cell) and the stiff and extreme suite in the same form; the C-60 across engines
+(:mod:`.c60_section`: the labelled schematic, the viewer playing c60-trip in every engine, the
+time series, the c60-on and c60-trip tables, the error budget, work-precision) and, when
+``clearbench c60 validate`` has written its JSON, the C-60 against the paper; then the detail:
+per scene a table of every run with its metrics and its figures (work-precision with its Pareto
+front, drift and creep over time) folded two per row; the tolerance campaigns
+(:mod:`.campaign_sections`) as tables; per engine the features it approximates or does not
+support; a glossary of every abbreviation the page uses. Figures are embedded as base64 PNG in
+the HTML and written as PNG files beside the Markdown; three.js is inlined for the viewer.
 """
 
 from __future__ import annotations
 
-import base64
 import html
 import json
 import logging
 import math
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
@@ -28,20 +31,39 @@ import numpy as np
 from clearbench.harness.measure.headline import (
     METRIC_LABELS,
     format_value,
-    headline,
     scene_metric_names,
 )
 from clearbench.harness.measure.units import unit_text
-from clearbench.harness.measure.verdicts import VERDICTS, run_verdict, verdict_text
-from clearbench.harness.report.c60_section import C60Section, build_section
+from clearbench.harness.measure.verdicts import VERDICTS, verdict_text
+from clearbench.harness.report.c60_section import (
+    EVENT_BOUND,
+    FLAG,
+    C60Section,
+    build_section,
+    c60_cell_texts,
+)
 from clearbench.harness.report.c60_section import section_html as c60_engines_html
 from clearbench.harness.report.c60_section import section_markdown as c60_engines_markdown
+from clearbench.harness.report.campaign_sections import campaign_html
+from clearbench.harness.report.conclusions import HEAD, conclusions, standing
 from clearbench.harness.report.engine_style import engine_colours
 from clearbench.harness.report.figures import time_series_figure, work_precision_figure
+from clearbench.harness.report.glossary import glossary_html
+from clearbench.harness.report.html_parts import figure_grid, heading, table
+from clearbench.harness.report.overview import (
+    NOT_RUN,
+    cell_lines,
+    engine_columns,
+    matrix_html,
+    matrix_markdown,
+    row_verdict,
+)
+from clearbench.harness.report.readme_table import results_document, write_results
+from clearbench.harness.report.viewer.payload import CSS as VIEWER_CSS
+from clearbench.harness.report.viewer.payload import viewer_scripts
 from clearbench.harness.run.store import ResultsStore
 from clearbench.harness.studies.campaign.report import load_written_sections
 from clearbench.harness.studies.campaign.report import render_markdown as campaign_section_markdown
-from clearbench.harness.studies.campaign.report import section_html as campaign_section_html
 from clearbench.harness.studies.sweep import work_precision_points
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.tags import STIFF
@@ -151,19 +173,6 @@ def _figures(store: ResultsStore, section: SceneSection,
 
 
 # ---------------------------------------------------------------------------- content helpers
-def _cell(row: dict | None, scene: Scene | None) -> tuple[str, str, str]:
-    """(verdict (a key of VERDICTS, "" when not run), headline figure, title: the run's
-    message and its failed expectations) of an overview cell."""
-    if row is None:
-        return "", "not run", ""
-    figures = json.loads(row["metrics"] or "{}")
-    name, value = headline(scene, figures) if scene is not None else ("", math.nan)
-    label = METRIC_LABELS.get(name, (name, ""))[0]
-    text = f"{label} {format_value(value, unit_text(name, scene, short=True))}" if name else ""
-    return (run_verdict(row["status"], row.get("expectations_passed"), figures), text,
-            _run_title(row))
-
-
 def _run_title(row) -> str:
     """The run's message and its failed expectations (a verdict cell's title)."""
     failed = [r["name"] for r in json.loads(row.get("expectations") or "[]")
@@ -219,14 +228,28 @@ def _folded(detail: str) -> str:
 # ---------------------------------------------------------------------------- HTML
 CSS = """
 body{font-family:system-ui,-apple-system,Segoe UI,Helvetica,Arial,sans-serif;margin:2em auto;
-max-width:1100px;color:#222;line-height:1.4;padding:0 1em}
+max-width:1100px;color:#222;line-height:1.4;padding:0 1em;overflow-wrap:anywhere}
 h1{font-size:1.6em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:2em}
 table{border-collapse:collapse;margin:.6em 0;font-size:.86em}
+caption{caption-side:top;text-align:left;font-weight:600;padding:.2em 0}
 th,td{border:1px solid #ccc;padding:.25em .5em;text-align:left;vertical-align:top}
-th{background:#f3f3f3}td.num{text-align:right;font-variant-numeric:tabular-nums}
-.status{font-weight:600}.small{color:#666;font-size:.85em}img{max-width:100%}
-.figs{display:flex;flex-wrap:wrap;gap:1em}.figs figure{margin:0}
+th{background:#f3f3f3}td.num{text-align:right;font-variant-numeric:tabular-nums;
+overflow-wrap:normal;white-space:nowrap}
+.scroll{max-width:100%;overflow-x:auto}
+.status{font-weight:600}.small{color:#555;font-size:.85em}img{max-width:100%}
+.figs{display:grid;grid-template-columns:repeat(2,minmax(0,1fr));gap:1em}
+.figs figure{margin:0}figure{margin:.6em 0}
+table.matrix{width:100%;table-layout:fixed;font-size:.8em}table.matrix th.scene{width:12%}
+table.matrix .line{padding:.15em .3em;margin:1px 0;border-radius:2px}
+td.notrun{color:#777;background:#fafafa}
+table.conclusions{font-size:.82em}table.conclusions td:first-child{white-space:nowrap}
+.toc{font-size:.9em;margin:.5em 0 1em}
+dl.glossary{display:grid;grid-template-columns:max-content 1fr;gap:.2em 1em;font-size:.9em}
+dl.glossary dt{font-weight:600}dl.glossary dd{margin:0}
+details>summary{cursor:pointer}
+@media print{details{display:block}.cb-viewer{break-inside:avoid}}
 """
+
 
 
 def _esc(value) -> str:
@@ -247,51 +270,39 @@ def _verdict_body(verdict: str, text: str) -> tuple[str, str]:
 def _run_verdict_td(run) -> str:
     """A per-scene table's verdict cell: the run's verdict (status and expectations together,
     as in the overview), its colour, and the message and failed expectations as its title."""
-    colour, body = _verdict_body(run_verdict(run["status"], run["expectations_passed"],
-                                             json.loads(run["metrics"] or "{}")), "")
+    colour, body = _verdict_body(row_verdict(run), "")
     return f"<td style='background:{colour}' title='{_esc(_run_title(run))}'>{body}</td>"
 
 
-def _verdict_td(verdict: str, text: str, title: str, scene: str, engine: str) -> str:
-    """An overview cell: the verdict's colour, symbol and name, the headline figure under it;
-    ``data-*`` attributes name the scene, engine and verdict for tools reading the page."""
-    colour, body = _verdict_body(verdict, text)
-    return (f"<td class='verdict' data-scene='{_esc(scene)}' data-engine='{_esc(engine)}' "
-            f"data-verdict='{_esc(verdict or 'not run')}' style='background:{colour}' "
-            f"title='{_esc(title)}'>{body}</td>")
-
-
-def _verdict_legend_html() -> str:
-    items = "".join(f"<tr><td style='background:{style.colour}'><span class='status'>"
-                    f"{_esc(verdict_text(name))}</span></td><td>{_esc(style.meaning)}</td></tr>"
-                    for name, style in VERDICTS.items())
-    return (f"<table class='legend'><tr><th>verdict</th><th>meaning</th></tr>{items}</table>"
-            "<p class='small'>Under the verdict: the scene's headline figure. Hover a cell for "
-            "the run's message and the expectations it failed (docs/harness.md: verdicts).</p>")
+def overview_rows(data: ReportData, stiff: bool, engines: list[str]) -> list:
+    """(scene, step text, engine -> cell lines) of the overview (``stiff``: of the stiff
+    suite's matrix)."""
+    texts = c60_cell_texts(data.c60_engines) if data.c60_engines else {}
+    rows = []
+    for section in data.sections:
+        if (section.scene is not None and STIFF in section.scene.tags) != stiff:
+            continue
+        by_label = {label: texts.get(row["key"], "")
+                    for label, row in section.representative.items()}
+        step = (f"dt {section.scene.time_step:g} {section.scene.units.time}"
+                if section.scene is not None else "")
+        rows.append((section.name, step, {
+            engine: cell_lines(section.representative, engine, section.scene, by_label)
+            for engine in engines}))
+    return rows
 
 
 def _overview_html(data: ReportData, stiff: bool) -> str:
-    sections = [s for s in data.sections
-                if (s.scene is not None and STIFF in s.scene.tags) == stiff]
-    if not sections:
-        return ""
-    head = "".join(f"<th>{_esc(label)}</th>" for label in data.engines)
-    body = []
-    for section in sections:
-        cells = "".join(_verdict_td(*_cell(section.representative.get(label), section.scene),
-                                    section.name, label)
-                        for label in data.engines)
-        step = f"{section.scene.time_step:g} {section.scene.units.time}" if section.scene else ""
-        body.append(f"<tr><td><a href='#scene-{_esc(section.name)}'>{_esc(section.name)}</a>"
-                    f"<br><span class='small'>dt {step}</span></td>{cells}</tr>")
+    engines = engine_columns(data.engines)
     title = "Stiff and extreme suite" if stiff else "Overview"
-    note = ("each engine at the case's own (hard) step" if stiff else
-            "each engine at the scene's comfortable step")
-    table_id = "stiff-matrix" if stiff else "overview-matrix"
-    return (f"<h2>{title}</h2><p class='small'>{note}: one verdict per run, from its status and "
-            "the scene's expectations together, and the scene's headline figure.</p>"
-            f"<table id='{table_id}'><tr><th>scene</th>{head}</tr>{''.join(body)}</table>"
-            + ("" if stiff else _verdict_legend_html()))
+    note = ("Each engine at the case's own (hard) step" if stiff else
+            "Each engine at the scene's comfortable step") + (
+        ": one column per engine (the reference first), one line per preset it ran the "
+        "scene with, its verdict from the run's status and the scene's expectations together, "
+        "and under it the failing expectation's value against its limit, the message of a run "
+        "that stopped, or the scene's headline figure. Hover a line for the whole text.")
+    return matrix_html(overview_rows(data, stiff, engines), engines, title,
+                       "stiff-matrix" if stiff else "overview-matrix", note, legend=not stiff)
 
 
 def _runs_table_html(section: SceneSection) -> str:
@@ -305,16 +316,19 @@ def _runs_table_html(section: SceneSection) -> str:
                         for c in columns)
         passed = run["expectations_passed"]
         mark = "—" if passed is None or (isinstance(passed, float) and math.isnan(passed)) \
-            else ("pass" if int(passed) else "FAIL")
+            else ("all passed" if int(passed) else "one failed")
         rows.append(
             f"<tr><td>{_esc(run['label'] + role)}</td><td class='num'>{run['time_step']:.3g}"
             f"</td>{_run_verdict_td(run)}<td>{mark}</td>{cells}"
             f"<td class='num'>{_esc(format_value(run['stepping_seconds_per_step'], 's'))}</td>"
             f"<td class='num'>"
             f"{_esc(format_value(run['stepping_seconds_per_simulated_second'], 's'))}</td></tr>")
-    return ("<table><tr><th>engine</th><th>dt</th><th>verdict</th><th>expectations</th>"
-            f"{head}<th>stepping / step</th><th>stepping / sim. unit</th></tr>"
-            f"{''.join(rows)}</table>")
+    unit = section.scene.units.time if section.scene is not None else ""
+    return (f"<div class='scroll'><table><caption>{_esc(section.name)}: every run"
+            f"</caption><thead><tr><th>engine</th><th>dt [{_esc(unit)}]</th><th>verdict</th>"
+            f"<th>expectations</th>{head}<th>stepping / step</th><th>stepping / "
+            f"{_esc(unit or 'time unit')} simulated</th></tr></thead><tbody>{''.join(rows)}"
+            "</tbody></table></div>")
 
 
 def _messages_html(section: SceneSection) -> str:
@@ -347,32 +361,29 @@ FIGURE_CAPTIONS = {
 def _section_html(section: SceneSection) -> str:
     scene = section.scene
     intro = _esc(scene.description) if scene is not None else ""
-    units = f" Units: {_esc(scene.units.describe())}." if scene is not None and hasattr(
-        scene.units, "describe") else ""
-    figures = "".join(
-        f"<figure><img alt='{_esc(title)} of {_esc(section.name)}' "
-        f"src='data:image/png;base64,{base64.b64encode(png).decode()}'>"
-        f"<figcaption class='small'><b>{_esc(title)}.</b> "
-        f"{_esc(FIGURE_CAPTIONS.get(title, ''))}</figcaption></figure>"
-        for title, png in section.figures.items())
+    units = (f" Units: length {scene.units.length}, mass {scene.units.mass}, time "
+             f"{scene.units.time}." if scene is not None else "")
+    figures = figure_grid([(png, f"{title}: {FIGURE_CAPTIONS.get(title, '')}")
+                           for title, png in section.figures.items()],
+                          f"Figures of {section.name}")
     notes = "".join(f"<p class='small'>{_esc(n)}</p>" for n in section.notes)
-    return (f"<h2 id='scene-{_esc(section.name)}'>{_esc(section.name)}</h2><p>{intro}{units}</p>"
-            f"{_runs_table_html(section)}{_messages_html(section)}"
-            f"<div class='figs'>{figures}</div>{notes}")
+    return (heading(3, section.name, f"scene-{section.name}") + f"<p>{intro}{units}</p>"
+            f"{_runs_table_html(section)}{_messages_html(section)}{figures}{notes}")
 
 
 def _engines_html(data: ReportData) -> str:
-    rows = "".join(f"<tr><td>{_esc(a)}</td><td>{_esc(b)}</td><td>{_esc(c)}</td>"
-                   f"<td>{_folded(d)}</td></tr>" for a, b, c, d in _engine_notes(data))
+    notes = [[a, b, c, _folded(d)] for a, b, c, d in _engine_notes(data)]
     versions = data.frame.groupby("label")["engine_version"].last() if len(data.frame) else {}
-    version_rows = "".join(f"<tr><td>{_esc(k)}</td><td>{_esc(v)}</td></tr>"
-                           for k, v in dict(versions).items())
-    table = (f"<table><tr><th>engine</th><th>feature</th><th>support</th><th>how</th></tr>"
-             f"{rows}</table>") if rows else "<p>Every feature used was native.</p>"
-    return ("<h2>Engines and their approximations</h2>"
-            f"<table><tr><th>engine</th><th>version</th></tr>{version_rows}</table>"
-            "<p class='small'>Features of the scenes run that an engine only approximates or "
-            f"does not support, as the engine states it (Engine.capabilities):</p>{table}")
+    version_table = table(["engine", "version"], [[k, v] for k, v in dict(versions).items()],
+                          "The engines' versions")
+    notes_table = (table(["engine", "feature", "support", "how"],
+                         [[_esc(a), _esc(b), _esc(c), d] for a, b, c, d in notes],
+                         "Features an engine approximates or does not support", raw=True)
+                   if notes else "<p>Every feature used was native.</p>")
+    return (heading(2, "Engines and their approximations", "engines") + version_table
+            + "<p class='small'>Features of the scenes run that an engine only approximates or "
+            "does not support, as the engine states it (Engine.capabilities):</p>"
+            + notes_table)
 
 
 def load_c60_validation(path: str | Path | None) -> dict | None:
@@ -401,29 +412,40 @@ def _c60_difference(value) -> str:
     return "-" if value is None else f"{100 * value:+.1f} %"
 
 
+def _c60_causes(validation: dict) -> list[tuple[list[str], str]]:
+    """Each distinct believed cause once, with the quantities (and differences) it
+    explains."""
+    grouped: dict[str, list[str]] = {}
+    for r in validation["rows"]:
+        if r.get("believed_cause"):
+            note = f" ({r['note']})" if r.get("note") else ""
+            grouped.setdefault(r["believed_cause"], []).append(
+                f"{r['quantity']}{note}: {_c60_difference(r['difference'])}")
+    return [(quantities, cause) for cause, quantities in grouped.items()]
+
+
 def _c60_html(validation: dict) -> str:
-    rows = "".join(
-        f"<tr><td>{_esc(r['quantity'])}{_esc(' (' + r['note'] + ')') if r['note'] else ''}"
-        f"</td><td>{_esc(r['unit'])}</td><td>{_c60_number(r['ours'])}</td>"
-        f"<td>{_c60_number(r['paper_simulated'])}</td><td>{_c60_number(r['paper_measured'])}"
-        f"</td><td>{_c60_difference(r['difference'])}</td></tr>" for r in validation["rows"])
-    causes = "".join(f"<li>{_esc(r['quantity'])}: {_c60_difference(r['difference'])}. What we "
-                     f"believe causes it: {_esc(r['believed_cause'])}</li>"
-                     for r in validation["rows"] if r.get("believed_cause"))
+    rows = [[r["quantity"] + (f" ({r['note']})" if r["note"] else ""), r["unit"],
+             _c60_number(r["ours"]), _c60_number(r["paper_simulated"]),
+             _c60_number(r["paper_measured"]), _c60_difference(r["difference"])]
+            for r in validation["rows"]]
+    causes = "".join(f"<li>{'; '.join(_esc(q) for q in quantities)}. What we believe causes "
+                     f"it: {_esc(cause)}</li>" for quantities, cause in _c60_causes(validation))
     findings = "".join(f"<li>{_esc(f)}</li>" for f in validation.get("findings", []))
-    figures = "".join(
-        f"<figure><img alt='{_esc(title)}' src='data:image/png;base64,"
-        f"{base64.b64encode(png).decode()}'><figcaption>{_esc(title)}</figcaption></figure>"
-        for title, png in validation.get("figure_png", {}).items())
-    return (f"<h2>{_esc(validation['title'])}</h2>"
-            f"<p class='small'>From <code>{_esc(validation['source'])}</code> (reference "
+    figures = figure_grid([(png, title) for title, png in
+                           validation.get("figure_png", {}).items()],
+                          "Force-displacement figures against the paper's", open_=True)
+    return (heading(2, validation["title"], "c60-paper")
+            + f"<p class='small'>From <code>{_esc(validation['source'])}</code> (reference "
             f"engine, preset {_esc(validation['preset'])}); paper: {_esc(validation['paper'])}."
             " Differences are relative to the measured value where there is one, else to the "
             "paper's simulated value; nothing is tuned to them.</p>"
-            "<table><tr><th>quantity</th><th>unit</th><th>ours</th><th>paper, simulated</th>"
-            f"<th>paper, measured</th><th>difference</th></tr>{rows}</table>"
-            f"<h3>Differences above 10 %</h3><ul class='small'>{causes}</ul>"
-            f"<h3>Findings</h3><ul class='small'>{findings}</ul>{figures}")
+            + table(["quantity", "unit", "ours", "paper, simulated", "paper, measured",
+                     "difference"], rows, "The reference engine's C-60 against the paper",
+                    numeric=(2, 3, 4, 5))
+            + heading(3, "Differences above 10 %", "c60-paper-differences")
+            + f"<ul class='small'>{causes}</ul>" + heading(3, "Findings", "c60-paper-findings")
+            + f"<ul class='small'>{findings}</ul>{figures}")
 
 
 def _c60_markdown(validation: dict, figure_files: dict) -> list[str]:
@@ -439,13 +461,65 @@ def _c60_markdown(validation: dict, figure_files: dict) -> list[str]:
                      f"{_c60_number(r['paper_measured'])} | "
                      f"{_c60_difference(r['difference'])} |")
     lines.append("")
-    lines += [f"- {_md_escape(r['quantity'])}: {_c60_difference(r['difference'])}. What we "
-              f"believe causes it: {_md_escape(r['believed_cause'])}"
-              for r in validation["rows"] if r.get("believed_cause")]
+    lines += [f"- {_md_escape('; '.join(quantities))}. What we believe causes it: "
+              f"{_md_escape(cause)}" for quantities, cause in _c60_causes(validation)]
     lines += [f"- {_md_escape(f)}" for f in validation.get("findings", [])]
     for title, path in figure_files.items():
         lines += ["", f"![{title}]({path})"]
     return lines + [""]
+
+
+def provenance(data: ReportData) -> str:
+    """Where the report's figures come from: the store, its runs and revisions."""
+    frame = data.frame
+    revisions = ", ".join(sorted(set(frame["git_revision"].str[:12]))) if len(frame) else "-"
+    return (f"{len(frame)} runs of the results store (revision {revisions}, "
+            f"{data.generated[:10]})")
+
+
+def results(data: ReportData) -> dict:
+    """The conclusions as the README's table takes them (:mod:`.readme_table`)."""
+    lines = conclusions(data.engines, data.sections, data.c60_engines)
+    return results_document(HEAD, [c.cells() for c in lines], standing(data.c60_validation),
+                            provenance(data))
+
+
+def _conclusions_html(data: ReportData) -> str:
+    lines = conclusions(data.engines, data.sections, data.c60_engines)
+    if not lines:
+        return ""
+    sentence = standing(data.c60_validation)
+    return (heading(2, "Conclusions", "conclusions")
+            + "<p class='small'>One line per engine and preset: the C-60's FC-1 against the "
+            "reference and the latch (c60-on), each trip event against the reference's "
+            "(c60-trip; " + _esc(FLAG) + f" beyond {100 * EVENT_BOUND:g} %), the cheapest "
+            "step whose FC-1 error and every finer step's stay within 1 % with its run's "
+            "cost, and the verdicts at each scene's comfortable step. The sections below give "
+            "each figure.</p>"
+            + table(HEAD, [c.cells() for c in lines], "Each engine and preset in one line",
+                    css_class="conclusions")
+            + (f"<p><b>The model against the paper.</b> {_esc(sentence)}</p>" if sentence
+               else ""))
+
+
+HEADING = re.compile(r"<h([23]) id='([^']+)'>(.*?)</h\1>")
+
+
+def table_of_contents(body: str) -> str:
+    """The page's h2 headings as links, each followed by its h3 headings' links in
+    parentheses: a compact paragraph (every heading has an id)."""
+    entries: list[tuple[str, list[str]]] = []
+    for level, ident, text in HEADING.findall(body):
+        link = f"<a href='#{ident}'>{text}</a>"
+        if level == "2" or not entries:
+            entries.append((link, []))
+        else:
+            entries[-1][1].append(link)
+    if not entries:
+        return ""
+    items = " · ".join(link + (f" <span class='small'>({', '.join(subs)})</span>" if subs
+                                else "") for link, subs in entries)
+    return f"<nav class='toc' id='toc'><b>Contents:</b> {items}</nav>"
 
 
 def render_html(data: ReportData) -> str:
@@ -456,25 +530,33 @@ def render_html(data: ReportData) -> str:
     revisions = ", ".join(sorted(set(frame["git_revision"].str[:12]))) if len(frame) else ""
     counts = frame["status"].value_counts().to_dict() if len(frame) else {}
     summary = ", ".join(f"{v} {k}" for k, v in sorted(counts.items()))
+    details = list(data.sections)
+    shown: dict[str, str] = {}        # campaign paragraphs already on the page
     body = [
-        "<h1>clearbench comparison report</h1>",
-        f"<p class='small'>Generated {data.generated} from store {_esc(data.store)}: "
-        f"{len(frame)} runs ({_esc(summary)}). Machines: {_esc(machines)}. Revisions: "
-        f"{_esc(revisions)}. Metrics are computed by the harness from each trajectory with "
-        "shared geometry, never taken from an engine; times are wall-clock seconds of "
-        "stepping alone.</p>",
+        _conclusions_html(data),
         _overview_html(data, stiff=False),
         _overview_html(data, stiff=True),
         c60_engines_html(data.c60_engines) if data.c60_engines else "",
         _c60_html(data.c60_validation) if data.c60_validation else "",
-        *(_section_html(s) for s in data.sections),
-        *(campaign_section_html(summary, pngs) for summary, pngs in data.campaigns),
+        (heading(2, "Each scene in detail", "scenes") if details else ""),
+        *(_section_html(s) for s in details),
+        (heading(2, "Tolerance campaigns", "campaigns") if data.campaigns else ""),
+        *(campaign_html(summary, pngs, shown) for summary, pngs in data.campaigns),
         _engines_html(data),
     ]
+    text = "".join(body)
+    text += glossary_html(text)
+    viewer = viewer_scripts() if "class='cb-viewer'" in text else ""
+    head = ("<h1>clearbench comparison report</h1>"
+            f"<p class='small'>Generated {data.generated} from store {_esc(data.store)}: "
+            f"{len(frame)} runs ({_esc(summary)}). Machines: {_esc(machines)}. Revisions: "
+            f"{_esc(revisions)}. Metrics are computed by the harness from each trajectory with "
+            "shared geometry, never taken from an engine; times are wall-clock seconds of "
+            "stepping alone.</p>")
     return ("<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
             "<meta name='viewport' content='width=device-width, initial-scale=1'>"
-            f"<title>clearbench report</title><style>{CSS}</style></head><body>"
-            f"{''.join(body)}</body></html>\n")
+            f"<title>clearbench report</title><style>{CSS}{VIEWER_CSS}</style></head><body>"
+            f"{head}{table_of_contents(text)}{text}{viewer}</body></html>\n")
 
 
 # ---------------------------------------------------------------------------- Markdown
@@ -487,40 +569,29 @@ def render_markdown(data: ReportData, figure_files: dict, c60_figure_files: dict
     lines = ["# clearbench comparison report", "",
              f"Generated {data.generated} from `{data.store}`: {len(data.frame)} runs. "
              "Full report with figures: `report.html`.", ""]
+    engines = engine_columns(data.engines)
     for stiff in (False, True):
-        sections = [s for s in data.sections
-                    if (s.scene is not None and STIFF in s.scene.tags) == stiff]
-        if not sections:
-            continue
-        lines += [f"## {'Stiff and extreme suite' if stiff else 'Overview'}", "",
-                  "| scene | " + " | ".join(data.engines) + " |",
-                  "|---|" + "---|" * len(data.engines)]
-        for section in sections:
-            cells = []
-            for label in data.engines:
-                verdict, text, _ = _cell(section.representative.get(label), section.scene)
-                cells.append(_md_escape(f"**{verdict_text(verdict)}** {text}".strip()
-                                        if verdict else text))
-            lines.append(f"| {section.name} | " + " | ".join(cells) + " |")
-        lines.append("")
-        if not stiff:
+        lines += matrix_markdown(overview_rows(data, stiff, engines), engines,
+                                 "Stiff and extreme suite" if stiff else "Overview")
+        if not stiff and data.sections:
             lines += ["Verdicts: " + "; ".join(f"{verdict_text(name)}: {style.meaning}"
-                                                for name, style in VERDICTS.items()) + ".", ""]
+                                                for name, style in VERDICTS.items())
+                      + f"; {NOT_RUN}: the engine has no run of the scene.", ""]
     if data.c60_engines:
         lines += c60_engines_markdown(data.c60_engines, c60_engines_figure)
     if data.c60_validation:
         lines += _c60_markdown(data.c60_validation, c60_figure_files or {})
     for section in data.sections:
         columns = _metric_columns(section)
+        unit = section.scene.units.time if section.scene is not None else ""
         lines += [f"### {section.name}", "",
-                  "| engine | dt | verdict | " + " | ".join(
+                  f"| engine | dt [{unit}] | verdict | " + " | ".join(
                       _column_head(c, section.scene) for c in columns) + " | stepping/step |",
                   "|---|---|---|" + "---|" * len(columns) + "---|"]
         for _, run in section.runs.sort_values(["label", "time_step"]).iterrows():
             figures = json.loads(run["metrics"] or "{}")
             role = " (fine ref)" if str(run["campaign"]).endswith(FINE_SUFFIX) else ""
-            verdict = verdict_text(run_verdict(run["status"], run["expectations_passed"],
-                                               figures))
+            verdict = verdict_text(row_verdict(run))
             lines.append(f"| {run['label']}{role} | {run['time_step']:.3g} | {verdict} | "
                          + " | ".join(format_value(figures.get(c)) for c in columns)
                          + f" | {format_value(run['stepping_seconds_per_step'], 's')} |")
@@ -581,9 +652,10 @@ def write_report(store: ResultsStore, out_dir: str | Path,
             name = f"figures/{section.name}-{index}.png"
             (out / name).write_bytes(png)
             figure_files.setdefault(section.name, {})[title] = name
+    write_results(results(data), out / "results.json")
     html_path = out / "report.html"
     md_path = out / "summary.md"
     html_path.write_text(render_html(data), encoding="utf-8")
     md_path.write_text(render_markdown(data, figure_files, c60_figure_files, c60_engines_figure),
                        encoding="utf-8")
-    return {"html": html_path, "markdown": md_path}
+    return {"html": html_path, "markdown": md_path, "results": out / "results.json"}

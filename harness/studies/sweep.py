@@ -149,8 +149,10 @@ def pareto_front(times: np.ndarray, errors: np.ndarray) -> np.ndarray:
 
 
 def work_precision_points(frame, scene_name: str):
-    """Work–precision points of one scene from a store DataFrame: one row per finished run
-    with an error, sorted by engine and step, with a ``pareto`` column over all engines.
+    """Work–precision points of one scene from a store DataFrame: one row per run with an
+    error, sorted by engine and step, with a ``pareto`` column over all engines: the front
+    of the runs that finished (status ok); a run that diverged (its error up to where it
+    stopped) is never on it.
 
     Columns: ``label``, ``time_step``, ``error``, ``stepping_seconds_per_simulated_second``,
     ``status``, ``campaign``, ``pareto``.
@@ -160,7 +162,12 @@ def work_precision_points(frame, scene_name: str):
     rows = rows[np.isfinite(rows["error"].astype(float))
                 & np.isfinite(rows["stepping_seconds_per_simulated_second"].astype(float))]
     rows = rows.sort_values(["label", "time_step"])
-    rows["pareto"] = pareto_front(rows["stepping_seconds_per_simulated_second"].to_numpy(),
-                                  rows["error"].to_numpy()) if len(rows) else []
+    finished = (rows["status"] == "ok").to_numpy()
+    front = np.zeros(len(rows), dtype=bool)
+    if finished.any():
+        front[finished] = pareto_front(
+            rows["stepping_seconds_per_simulated_second"].to_numpy()[finished],
+            rows["error"].to_numpy()[finished])
+    rows["pareto"] = front
     return rows[["label", "time_step", "error", "stepping_seconds_per_simulated_second",
                  "status", "campaign", "pareto", "key"]]

@@ -16,6 +16,7 @@ import numpy as np
 
 from clearbench.harness.report.figures import _png, _pyplot
 from clearbench.harness.studies.campaign.definition import CampaignDefinition
+from clearbench.harness.studies.campaign.formatting import counts_text, parameters_text
 from clearbench.harness.studies.campaign.formatting import format_number as _fmt
 from clearbench.harness.studies.campaign.results import definition_summary
 
@@ -173,7 +174,7 @@ def _stop_line(summary: dict) -> str:
     last = summary["stages"][-1]
     text = (f"Stopped: **{summary['stop']}** after {summary['runs']} runs of a budget of "
             f"{summary['budget']} (stages of {', '.join(str(s['runs']) for s in summary['stages'])}"
-            f" runs; design rows from {summary['sources']}). Targets: Q2 >= "
+            f" runs; design rows: {counts_text(summary['sources'])}). Targets: Q2 >= "
             f"{settings['q2']:g} ({settings['validation']}"
             + (f", {settings['folds']} folds" if settings["validation"] == "k-fold" else "")
             + f") for every output; {targets}.")
@@ -187,7 +188,8 @@ def render_markdown(summary: dict, figure_files: list[str]) -> str:
     d = summary["definition"]
     inputs = [i["name"] for i in d["inputs"]]
     lines = [f"## Metamodel campaign `{d['name']}`", "",
-             f"Scene `{d['scene']}` {d['scene_parameters'] or ''} in `{d['engine']}`, design "
+             f"Scene `{d['scene']}`{parameters_text(d['scene_parameters'])} in "
+             f"`{d['engine']}`, design "
              f"`{d['design']}`, seed {d['seed']}. Metamodels tried: "
              f"{', '.join(summary['settings']['candidates'])} (chaos up to total degree "
              f"{summary['settings']['max_degree']}, terms by LARS); the one with the best Q2 "

@@ -20,6 +20,7 @@ from scipy import stats
 from clearbench.harness.report.figures import _png, _pyplot
 from clearbench.harness.run.store import ResultsStore
 from clearbench.harness.studies.campaign.definition import CampaignDefinition, CampaignError
+from clearbench.harness.studies.campaign.formatting import counts_text, parameters_text
 from clearbench.harness.studies.campaign.formatting import format_number as _fmt
 from clearbench.harness.studies.campaign.results import (
     definition_summary,
@@ -236,10 +237,11 @@ def _definition_lines(summary: dict) -> list[str]:
         + f" in [{i['lower']:g}, {i['upper']:g}] {i['unit']})" for i in d["inputs"])
     speed = summary["throughput"]
     return [
-        f"Scene `{d['scene']}` {d['scene_parameters'] or ''} in `{d['engine']}`, design "
+        f"Scene `{d['scene']}`{parameters_text(d['scene_parameters'])} in `{d['engine']}`, design "
         f"`{d['design']}`, seed {d['seed']}, {summary['samples_planned']} samples planned; "
-        f"statuses: {summary['statuses']}."
-        + (f" Runs by source: {summary['sources']} (given: taken from a campaign CSV)."
+        f"statuses: {counts_text(summary['statuses'])}."
+        + (f" Runs by source: {counts_text(summary['sources'])} (given: taken from a campaign "
+           "CSV)."
            if summary.get("sources", {}).get("given") else ""),
         f"Inputs: {inputs}.",
         f"Throughput (campaign log): {speed['samples']} samples in {speed['sessions']} "
