@@ -58,10 +58,19 @@ def register(name: str, tags: Iterable[str], summary: str, **fixed_parameters):
         if name in SCENES:
             raise ValueError(f"scene {name!r} registered twice")
 
+        positional = [name for name, p in inspect.signature(factory).parameters.items()
+                      if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
+
         @functools.wraps(factory)
         def build(*arguments, **parameters) -> Scene:
-            bound = inspect.signature(factory).bind_partial(*arguments, **parameters)
-            scene = factory(**{**fixed_parameters, **bound.arguments})
+            if len(arguments) > len(positional):
+                raise TypeError(f"{name}: {len(arguments)} positional arguments given, "
+                                f"the factory takes at most {len(positional)}")
+            by_position = dict(zip(positional[:len(arguments)], arguments, strict=True))
+            twice = sorted(set(by_position) & set(parameters))
+            if twice:
+                raise TypeError(f"{name}: {twice[0]!r} given by position and by name")
+            scene = factory(**{**fixed_parameters, **by_position, **parameters})
             return dataclasses.replace(scene, name=name, tags=tags)
 
         SCENES[name] = SceneEntry(name, build, tags, summary)

@@ -29,7 +29,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import integrate
 
 from clearbench.scenarios.analytic.common import as_times, require_non_negative, require_positive
 
@@ -56,6 +55,7 @@ def hoop_over_edge_pivot_time(v0: float, radius: float, g: float) -> float:
     leave = hoop_over_edge_leave_angle(v0, radius, g)
     if leave == 0.0:
         return 0.0
+    from scipy import integrate  # on use: scipy is slow to import for `list`
     value, _ = integrate.quad(lambda theta: 1.0 / _pivot_rate(theta, v0, radius, g), 0.0,
                               leave, epsabs=0.0, epsrel=1e-13)
     return float(value)
@@ -110,6 +110,7 @@ def hoop_over_edge_path(t, v0: float, radius: float, g: float, edge_distance: fl
     out[sliding] = np.stack([v0 * times[sliding], np.zeros(np.count_nonzero(sliding))], -1)
     pivoting = (times >= start) & (times < start + duration)
     if np.any(pivoting):
+        from scipy import integrate  # on use: scipy is slow to import for `list`
         solution = integrate.solve_ivp(
             lambda _, y: (y[1], g / radius * math.sin(y[0])), (0.0, duration),
             (0.0, v0 / radius), method="DOP853", rtol=1e-12, atol=1e-14, dense_output=True)
