@@ -49,30 +49,12 @@ SPHERE, BOX, CAPSULE, CYLINDER, PLANE, CIRCLE, ARC, RECTANGLE, DISC, BORE = (
 SHAPE_KINDS = gaps.SHAPE_KIND_NAMES
 
 #: Canonical pairs (kind on A, kind on B) -> number of slots; reversed orders are mirrored.
+#: Derived from the kernels' one declaration of the pairs and their slots
+#: (:data:`clearbench.kernels.gaps.PAIR_SLOTS`); a pair whose number of candidates changes
+#: with the configuration (slots None there) is not supported here (:data:`NOT_PORTED`).
 CANONICAL_PAIRS = {
-    (PLANE, SPHERE): 1,
-    (PLANE, BOX): 8,
-    (PLANE, CAPSULE): 2,
-    (PLANE, CYLINDER): 8,
-    (PLANE, CIRCLE): 1,
-    (PLANE, ARC): 1,
-    (SPHERE, SPHERE): 1,
-    (BOX, SPHERE): 1,
-    (CAPSULE, SPHERE): 1,
-    (CYLINDER, SPHERE): 1,
-    (CIRCLE, CYLINDER): 1,
-    (ARC, CYLINDER): 1,
-    (RECTANGLE, SPHERE): 1,
-    (RECTANGLE, CYLINDER): 8,
-    (RECTANGLE, CIRCLE): 1,
-    (RECTANGLE, ARC): 1,
-    (DISC, SPHERE): 1,
-    (DISC, CYLINDER): 8,
-    (DISC, CIRCLE): 1,
-    (DISC, ARC): 1,
-    (CIRCLE, BORE): 1,
-    (ARC, BORE): 1,
-    (CYLINDER, BORE): 2,
+    (SHAPE_KINDS[kind_a], SHAPE_KINDS[kind_b]): slots
+    for (kind_a, kind_b), slots in gaps.PAIR_SLOTS.items() if slots is not None
 }
 #: Gap [L] the worker hands Siconos for a dropped slot (a candidate off a bounded face, deeper
 #: than its depth, outside a bore's angles or length): far beyond any activation threshold

@@ -1,0 +1,94 @@
+"""Plane (A) against sphere, box, capsule and cylinder (B). The plane's material is below its
+shape-frame z = 0; its +z axis is the normal (from A toward B)."""
+
+from __future__ import annotations
+
+from clearbench.kernels.gaps.staging import stage_contact
+from clearbench.kernels.gaps.vectors import (
+    add,
+    axpy,
+    column_of,
+    cross,
+    dot,
+    norm,
+    scaled,
+    sub,
+    to_world,
+)
+from clearbench.kernels.jit import njit
+
+
+@njit(cache=True, inline="always")
+def plane_point(plane_position, normal, point, radius, index, stage):
+    """Contact of ``point`` swept by ``radius`` (a sphere; 0 for a bare point)."""
+    height = dot(sub(point, plane_position), normal)
+    stage_contact(stage, index, height - radius, axpy(-height, normal, point), normal)
+
+
+@njit(cache=True)
+def plane_sphere(plane_position, plane_rotation, centre, radius, stage):
+    plane_point(plane_position, column_of(plane_rotation, 2), centre, radius, 0, stage)
+    return 1
+
+
+@njit(cache=True)
+def plane_box(plane_position, plane_rotation, box_position, box_rotation, half_extents,
+              stage):
+    normal = column_of(plane_rotation, 2)
+    for index in range(8):
+        sx = 1.0 if index & 4 else -1.0
+        sy = 1.0 if index & 2 else -1.0
+        sz = 1.0 if index & 1 else -1.0
+        local = (sx * half_extents[0], sy * half_extents[1], sz * half_extents[2])
+        corner = to_world(box_position, box_rotation, local)
+        plane_point(plane_position, normal, corner, 0.0, index, stage)
+    return 8
+
+
+@njit(cache=True)
+def plane_capsule(plane_position, plane_rotation, position, rotation, radius, half_length,
+                  stage):
+    normal = column_of(plane_rotation, 2)
+    axis = column_of(rotation, 2)
+    plane_point(plane_position, normal, axpy(-half_length, axis, position), radius, 0, stage)
+    plane_point(plane_position, normal, axpy(half_length, axis, position), radius, 1, stage)
+    return 2
+
+
+@njit(cache=True)
+def _lowest_direction(normal, rotation):
+    """Unit vector in the shape's xy-plane most opposed to ``normal`` (the shape's x axis when
+    that plane is parallel to the contact plane), and ``z x lowest``, 90 degrees further."""
+    axis = column_of(rotation, 2)
+    down = axpy(-dot(normal, axis), axis, normal)
+    length = norm(down)
+    if length > 0.0:
+        lowest = scaled(down, -1.0 / length)
+    else:
+        lowest = column_of(rotation, 0)
+    return lowest, cross(axis, lowest)
+
+
+@njit(cache=True)
+def plane_cylinder(plane_position, plane_rotation, position, rotation, radius, half_length,
+                   stage):
+    """Eight rim candidates: on each end rim the lowest point and the points 90, 180 and 270
+    degrees further round. Indices 0 and 1 are the two lowest rim points (the support of a
+    lying cylinder); a standing cylinder gets 4 points on its bottom rim."""
+    normal = column_of(plane_rotation, 2)
+    axis = column_of(rotation, 2)
+    lowest, quarter = _lowest_direction(normal, rotation)
+    for index in range(8):
+        end = -half_length if index % 2 == 0 else half_length
+        turn = index // 2  # 0, 1, 2, 3 quarter turns from the lowest point
+        if turn == 0:
+            offset = scaled(lowest, radius)
+        elif turn == 1:
+            offset = scaled(quarter, radius)
+        elif turn == 2:
+            offset = scaled(lowest, -radius)
+        else:
+            offset = scaled(quarter, -radius)
+        point = add(axpy(end, axis, position), offset)
+        plane_point(plane_position, normal, point, 0.0, index, stage)
+    return 8
