@@ -17,8 +17,10 @@ planes        plane against sphere, box, capsule, cylinder
 spheres       sphere against sphere, box, capsule, cylinder
 segments      closest points of segments; capsule against capsule
 boxes         box against box
-rings         ring (circle, arc) against a plane and against a cylinder's lateral surface
-faces         bounded faces (rectangle, disc) against sphere, cylinder, ring
+face_solids   the solid behind a face (plane, rectangle, disc) and the signed distance to it
+faces         a face's solid against sphere, cylinder and ring
+ring_faces    ring (circle, arc) against a face's solid: support points and deepest points
+rings         ring (circle, arc) against a cylinder's lateral surface
 bores         ring or journal inside a bore
 dispatch      the dispatch on codes, canonical order and mirroring; the two entry points
 enclosing     a ring that must enclose its journal (measurement side, plain Python)
@@ -43,6 +45,7 @@ from clearbench.kernels.gaps.codes import (
     CIRCLE,
     CYLINDER,
     DISC,
+    DROPPING_KINDS,
     MAX_CONTACTS_PER_PAIR,
     NUMBER_OF_KINDS,
     PAIR_SLOTS,
@@ -65,6 +68,7 @@ __all__ = [
     "CIRCLE",
     "CYLINDER",
     "DISC",
+    "DROPPING_KINDS",
     "MAX_CONTACTS_PER_PAIR",
     "NUMBER_OF_KINDS",
     "PAIR_SLOTS",

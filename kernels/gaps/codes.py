@@ -30,20 +30,23 @@ NUMBER_OF_KINDS = len(SHAPE_KIND_NAMES)
 
 #: Length of the packed parameter vector of every shape.
 PARAMETER_COUNT = 8
-#: Upper bound of the contacts one pair can return (box corners, box clipping, cylinder rims).
+#: Upper bound of the contacts one pair can return (box corners, box clipping, cylinder rims,
+#: a ring's support points and minima against a face).
 MAX_CONTACTS_PER_PAIR = 8
 
 #: Pairs implemented with the first kind on body A (the reversed order is handled by swapping),
 #: and the number of candidate slots of each in ``pair_contact_slots`` (one interaction per slot
 #: for an engine that follows candidates from step to step); None where the number of
-#: candidates changes with the configuration (box clipping, parallel capsule axes).
+#: candidates changes with the configuration (box clipping, parallel capsule axes). A ring
+#: against a face (plane, rectangle, disc) has 8: its 6 support points and 2 deepest points
+#: (:data:`.ring_faces.RING_FACE_SLOTS`).
 PAIR_SLOTS = {
     (PLANE, SPHERE): 1,
     (PLANE, BOX): 8,
     (PLANE, CAPSULE): 2,
     (PLANE, CYLINDER): 8,
-    (PLANE, CIRCLE): 1,
-    (PLANE, ARC): 1,
+    (PLANE, CIRCLE): 8,
+    (PLANE, ARC): 8,
     (SPHERE, SPHERE): 1,
     (BOX, SPHERE): 1,
     (CAPSULE, SPHERE): 1,
@@ -54,16 +57,20 @@ PAIR_SLOTS = {
     (ARC, CYLINDER): 1,
     (RECTANGLE, SPHERE): 1,
     (RECTANGLE, CYLINDER): 8,
-    (RECTANGLE, CIRCLE): 1,
-    (RECTANGLE, ARC): 1,
+    (RECTANGLE, CIRCLE): 8,
+    (RECTANGLE, ARC): 8,
     (DISC, SPHERE): 1,
     (DISC, CYLINDER): 8,
-    (DISC, CIRCLE): 1,
-    (DISC, ARC): 1,
+    (DISC, CIRCLE): 8,
+    (DISC, ARC): 8,
     (CIRCLE, BORE): 1,
     (ARC, BORE): 1,
     (CYLINDER, BORE): 2,
 }
+#: Kinds whose pairs can leave a slot empty (``pair_contact_slots``'s kept False): a bore's
+#: candidate outside its angles or length, or deeper than its depth. Every other pair fills
+#: every slot with a candidate (a face's solid has a gap everywhere).
+DROPPING_KINDS = (BORE,)
 #: The canonical pairs, in the order of :data:`PAIR_SLOTS`.
 CANONICAL_PAIRS = tuple(PAIR_SLOTS)
 

@@ -25,14 +25,9 @@ from clearbench.kernels.gaps.codes import (
     SPHERE,
     TWO_PI,
 )
-from clearbench.kernels.gaps.faces import (
-    face_bounds,
-    face_candidates,
-    inside_face,
-    keep_inside_face,
-)
+from clearbench.kernels.gaps.faces import face_contacts
 from clearbench.kernels.gaps.planes import plane_box, plane_capsule, plane_cylinder, plane_sphere
-from clearbench.kernels.gaps.rings import plane_ring, ring_cylinder
+from clearbench.kernels.gaps.rings import ring_cylinder
 from clearbench.kernels.gaps.segments import capsule_capsule
 from clearbench.kernels.gaps.spheres import (
     box_sphere,
@@ -61,21 +56,13 @@ def _canonical_contacts(kind_a, params_a, position_a, rotation_a, kind_b, params
         if kind_b == CYLINDER:
             return plane_cylinder(position_a, rotation_a, position_b, rotation_b, params_b[0],
                                   params_b[1], stage)
-        if kind_b == CIRCLE:
-            return plane_ring(position_a, rotation_a, position_b, rotation_b, params_b[0], 0.0,
-                              TWO_PI, False, stage)
-        if kind_b == ARC:
-            return plane_ring(position_a, rotation_a, position_b, rotation_b, params_b[0],
-                              params_b[1], params_b[2] - params_b[1], True, stage)
+        if kind_b == CIRCLE or kind_b == ARC:
+            return face_contacts(kind_a, params_a, position_a, rotation_a, kind_b, params_b,
+                                 position_b, rotation_b, stage)
         return -1
     if kind_a == RECTANGLE or kind_a == DISC:
-        count = face_candidates(position_a, rotation_a, kind_b, params_b, position_b,
-                                rotation_b, stage)
-        if count < 0:
-            return -1
-        radius, depth = face_bounds(kind_a, params_a)
-        return keep_inside_face(position_a, rotation_a, params_a[0], params_a[1], radius,
-                                depth, count, stage)
+        return face_contacts(kind_a, params_a, position_a, rotation_a, kind_b, params_b,
+                             position_b, rotation_b, stage)
     if kind_b == SPHERE:
         if kind_a == SPHERE:
             return sphere_sphere(position_a, params_a[0], position_b, params_b[0], stage)
@@ -245,17 +232,9 @@ def pair_contacts(kind_a, params_a, position_a, rotation_a, kind_b, params_b, po
 @njit(cache=True)
 def _canonical_slots(kind_a, params_a, position_a, rotation_a, kind_b, params_b, position_b,
                      rotation_b, stage, work_1, work_2, out_kept):
-    """:func:`_canonical_contacts` without compaction: every candidate of a bounded face or a
-    bore stays in its slot and ``out_kept`` flags the ones the bounds keep. Returns the number
+    """:func:`_canonical_contacts` without compaction: every candidate of a bore stays in its
+    slot and ``out_kept`` flags the ones the bore's bounds keep. Returns the number
     of slots (-1 for a pair not in CANONICAL_PAIRS)."""
-    if kind_a == RECTANGLE or kind_a == DISC:
-        slots = face_candidates(position_a, rotation_a, kind_b, params_b, position_b,
-                                rotation_b, stage)
-        radius, depth = face_bounds(kind_a, params_a)
-        for k in range(slots):
-            out_kept[k] = inside_face(position_a, rotation_a, params_a[0], params_a[1], radius,
-                                      depth, stage, k)
-        return slots
     if kind_b == BORE:
         slots, kept_0, kept_1 = bore_slots(kind_a, params_a, position_a, rotation_a, params_b,
                                            position_b, rotation_b, stage)
@@ -282,11 +261,11 @@ def pair_contact_slots(kind_a, params_a, position_a, rotation_a, kind_b, params_
                        rotation_b, out_gap, out_point_a, out_point_b, out_frame, out_kept):
     """:func:`pair_contacts` with every candidate in a fixed slot, dropped or not.
 
-    A bounded face (rectangle, disc) drops the candidates off the face or deeper than its
-    depth, a bore those outside its angles or length; :func:`pair_contacts` compacts the kept
-    ones to the front. Here slot k is always the same candidate of the kernel (an engine with
-    one interaction per candidate follows it from step to step) and ``out_kept[k]`` says
-    whether the bounds keep it; the kept slots, in order, are :func:`pair_contacts`'s output.
+    A bore drops the candidates outside its angles or length, or deeper than its depth;
+    :func:`pair_contacts` compacts the kept ones to the front. Here slot k is always the same
+    candidate of the kernel (an engine with one interaction per candidate follows it from step
+    to step) and ``out_kept[k]`` says whether the bounds keep it; the kept slots, in order, are
+    :func:`pair_contacts`'s output.
     A dropped slot holds the kernel's candidate before the bound applied; a journal with no
     axial overlap with its bore fills its two slots with its centre, a gap 0 and a normal
     across the bore axis. Pairs that drop nothing fill every slot with a kept candidate.

@@ -1,68 +1,76 @@
-"""Bounded plane faces (rectangle, disc; A) against X (B): the plane kernels, then the candidates
-whose point on the face lies outside its boundary, or deeper than its depth, are dropped."""
+"""Faces with a solid behind them (plane, rectangle, disc; A) against sphere, cylinder and ring
+(B): every candidate's gap is its signed distance to the face's solid
+(:func:`~.face_solids.face_solid_distance`), so a partner crossing a bounded face's edge meets
+the edge (its gap and normal continuous), and one gone round behind the solid meets its back.
+"""
 
 from __future__ import annotations
 
-from clearbench.kernels.gaps.codes import ARC, CIRCLE, CYLINDER, DISC, SPHERE, TWO_PI
-from clearbench.kernels.gaps.planes import plane_cylinder, plane_sphere
-from clearbench.kernels.gaps.rings import plane_ring
-from clearbench.kernels.gaps.staging import copy_staged, within_depth
-from clearbench.kernels.gaps.vectors import to_local
+from clearbench.kernels.gaps.codes import ARC, CIRCLE, CYLINDER, SPHERE, TWO_PI
+from clearbench.kernels.gaps.face_solids import face_solid_distance, face_solid_parameters
+from clearbench.kernels.gaps.planes import cylinder_rim_point, lowest_direction
+from clearbench.kernels.gaps.ring_faces import ring_face
+from clearbench.kernels.gaps.staging import stage_contact
+from clearbench.kernels.gaps.vectors import column_of, rotate, scaled, sub, to_local, to_world
 from clearbench.kernels.jit import njit
 
 
 @njit(cache=True, inline="always")
-def inside_face(plane_position, plane_rotation, half_x, half_y, radius, depth, stage, k):
-    """True if the staged contact ``k`` lies in the face: its point on A (row 1 of the stage)
-    within |x| <= half_x and |y| <= half_y (rectangle, radius < 0) or x^2 + y^2 <= radius^2
-    (disc) in the face's frame, and its gap not below -depth (depth 0: no bound)."""
-    if not within_depth(depth, stage, k):
-        return False
-    point = (stage[k, 1, 0], stage[k, 1, 1], stage[k, 1, 2])
-    local = to_local(plane_position, plane_rotation, point)
-    if radius >= 0.0:
-        return local[0] * local[0] + local[1] * local[1] <= radius * radius
-    return abs(local[0]) <= half_x and abs(local[1]) <= half_y
+def _stage_point(index, point, radius, kind, size_1, size_2, depth, face_position,
+                 face_rotation, stage):
+    """Stage the contact of the world ``point`` swept by ``radius`` (0: a bare point) with the
+    face's solid: gap = the point's signed distance to the solid - radius."""
+    local = to_local(face_position, face_rotation, point)
+    distance, gradient = face_solid_distance(kind, size_1, size_2, depth, local)
+    on_face = sub(local, scaled(gradient, distance))
+    stage_contact(stage, index, distance - radius, to_world(face_position, face_rotation,
+                                                            on_face),
+                  rotate(face_rotation, gradient))
 
 
 @njit(cache=True)
-def keep_inside_face(plane_position, plane_rotation, half_x, half_y, radius, depth, count,
-                     stage):
-    """Keep the staged contacts that lie in the face (:func:`inside_face`). Returns the
-    number kept (compacted to the front, order preserved)."""
-    kept = 0
-    for k in range(count):
-        if inside_face(plane_position, plane_rotation, half_x, half_y, radius, depth, stage,
-                       k):
-            if kept != k:
-                copy_staged(stage, k, kept)
-            kept += 1
-    return kept
+def face_sphere(kind, size_1, size_2, depth, face_position, face_rotation, centre, radius,
+                stage):
+    """Sphere (B) against a bounded face's solid (A): one candidate, its centre's distance to
+    the solid minus its radius."""
+    _stage_point(0, centre, radius, kind, size_1, size_2, depth, face_position, face_rotation,
+                 stage)
+    return 1
+
+
+@njit(cache=True)
+def face_cylinder(kind, size_1, size_2, depth, face_position, face_rotation, position,
+                  rotation, radius, half_length, stage):
+    """Cylinder (B) against a bounded face's solid (A): the eight rim points of the plane pair
+    (:func:`~.planes.plane_cylinder`, chosen with respect to the face's normal), each with its
+    distance to the solid. The lateral surface against the face's edge is not a candidate."""
+    normal = column_of(face_rotation, 2)
+    axis = column_of(rotation, 2)
+    lowest, quarter = lowest_direction(normal, rotation)
+    for index in range(8):
+        point = cylinder_rim_point(index, position, axis, lowest, quarter, radius, half_length)
+        _stage_point(index, point, 0.0, kind, size_1, size_2, depth, face_position,
+                     face_rotation, stage)
+    return 8
 
 
 @njit(cache=True, inline="always")
-def face_candidates(plane_position, plane_rotation, kind_b, params_b, position_b, rotation_b,
-                    stage):
-    """Candidates of a bounded face's plane (A) against X (B) before the face's bounds apply;
-    -1 for an X no bounded face is paired with."""
+def face_contacts(kind_a, params_a, position_a, rotation_a, kind_b, params_b, position_b,
+                  rotation_b, stage):
+    """Candidates of a face's solid (A: plane, rectangle, disc) against X (B: sphere,
+    cylinder, circle, arc); -1 for an X this module does not pair with a face."""
+    size_1, size_2, depth = face_solid_parameters(kind_a, params_a)
     if kind_b == SPHERE:
-        return plane_sphere(plane_position, plane_rotation, position_b, params_b[0], stage)
+        return face_sphere(kind_a, size_1, size_2, depth, position_a, rotation_a, position_b,
+                           params_b[0], stage)
     if kind_b == CYLINDER:
-        return plane_cylinder(plane_position, plane_rotation, position_b, rotation_b,
-                              params_b[0], params_b[1], stage)
+        return face_cylinder(kind_a, size_1, size_2, depth, position_a, rotation_a,
+                             position_b, rotation_b, params_b[0], params_b[1], stage)
     if kind_b == CIRCLE:
-        return plane_ring(plane_position, plane_rotation, position_b, rotation_b, params_b[0],
-                          0.0, TWO_PI, False, stage)
+        return ring_face(kind_a, size_1, size_2, depth, position_a, rotation_a, position_b,
+                         rotation_b, params_b[0], 0.0, TWO_PI, False, stage)
     if kind_b == ARC:
-        return plane_ring(plane_position, plane_rotation, position_b, rotation_b, params_b[0],
-                          params_b[1], params_b[2] - params_b[1], True, stage)
+        return ring_face(kind_a, size_1, size_2, depth, position_a, rotation_a, position_b,
+                         rotation_b, params_b[0], params_b[1], params_b[2] - params_b[1], True,
+                         stage)
     return -1
-
-
-@njit(cache=True, inline="always")
-def face_bounds(kind, params):
-    """(radius, depth) of a bounded face: a disc's radius, -1 for a rectangle; depth 0: no
-    bound."""
-    radius = params[0] if kind == DISC else -1.0
-    depth = params[1] if kind == DISC else params[2]
-    return radius, depth

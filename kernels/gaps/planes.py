@@ -56,7 +56,7 @@ def plane_capsule(plane_position, plane_rotation, position, rotation, radius, ha
 
 
 @njit(cache=True)
-def _lowest_direction(normal, rotation):
+def lowest_direction(normal, rotation):
     """Unit vector in the shape's xy-plane most opposed to ``normal`` (the shape's x axis when
     that plane is parallel to the contact plane), and ``z x lowest``, 90 degrees further."""
     axis = column_of(rotation, 2)
@@ -69,6 +69,23 @@ def _lowest_direction(normal, rotation):
     return lowest, cross(axis, lowest)
 
 
+@njit(cache=True, inline="always")
+def cylinder_rim_point(index, position, axis, lowest, quarter, radius, half_length):
+    """Rim candidate ``index`` (0..7) of a cylinder: on the end rim -half_length (even index)
+    or +half_length (odd), the point ``index // 2`` quarter turns from ``lowest``."""
+    end = -half_length if index % 2 == 0 else half_length
+    turn = index // 2  # 0, 1, 2, 3 quarter turns from the lowest point
+    if turn == 0:
+        offset = scaled(lowest, radius)
+    elif turn == 1:
+        offset = scaled(quarter, radius)
+    elif turn == 2:
+        offset = scaled(lowest, -radius)
+    else:
+        offset = scaled(quarter, -radius)
+    return add(axpy(end, axis, position), offset)
+
+
 @njit(cache=True)
 def plane_cylinder(plane_position, plane_rotation, position, rotation, radius, half_length,
                    stage):
@@ -77,18 +94,8 @@ def plane_cylinder(plane_position, plane_rotation, position, rotation, radius, h
     lying cylinder); a standing cylinder gets 4 points on its bottom rim."""
     normal = column_of(plane_rotation, 2)
     axis = column_of(rotation, 2)
-    lowest, quarter = _lowest_direction(normal, rotation)
+    lowest, quarter = lowest_direction(normal, rotation)
     for index in range(8):
-        end = -half_length if index % 2 == 0 else half_length
-        turn = index // 2  # 0, 1, 2, 3 quarter turns from the lowest point
-        if turn == 0:
-            offset = scaled(lowest, radius)
-        elif turn == 1:
-            offset = scaled(quarter, radius)
-        elif turn == 2:
-            offset = scaled(lowest, -radius)
-        else:
-            offset = scaled(quarter, -radius)
-        point = add(axpy(end, axis, position), offset)
+        point = cylinder_rim_point(index, position, axis, lowest, quarter, radius, half_length)
         plane_point(plane_position, normal, point, 0.0, index, stage)
     return 8

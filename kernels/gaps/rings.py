@@ -1,5 +1,6 @@
-"""Ring (circle or arc) against a plane and against the lateral surface of a cylinder: the ring
-angle of the nearest (or farthest) point from a line, and the lowest point over a plane."""
+"""Ring (circle or arc) against the lateral surface of a cylinder: the ring angle of the point
+nearest (or farthest from) a line, shared with the ring inside a bore (:mod:`.bores`). A ring
+against a face is :mod:`.ring_faces`."""
 
 from __future__ import annotations
 
@@ -8,7 +9,6 @@ import math
 import numpy as np
 
 from clearbench.kernels.gaps.codes import TWO_PI
-from clearbench.kernels.gaps.planes import plane_point
 from clearbench.kernels.gaps.staging import stage_contact
 from clearbench.kernels.gaps.vectors import (
     add,
@@ -201,30 +201,4 @@ def ring_cylinder(ring_position, ring_rotation, ring_radius, start_angle, span, 
     ring_point = add(ring_position, add(scaled(e1, ring_radius * c),
                                           scaled(e2, ring_radius * s)))
     stage_contact(stage, 0, distance - cylinder_radius, ring_point, inward)
-    return 1
-
-
-@njit(cache=True)
-def plane_ring(plane_position, plane_rotation, position, rotation, radius, start_angle, span,
-               is_arc, stage):
-    """Lowest point of a circle (or an arc of it) with respect to the plane normal."""
-    normal = column_of(plane_rotation, 2)
-    e1 = column_of(rotation, 0)
-    e2 = column_of(rotation, 1)
-    # height(theta) - height(centre) = radius (cos(theta) e1.m + sin(theta) e2.m)
-    c1 = dot(e1, normal)
-    c2 = dot(e2, normal)
-    if c1 == 0.0 and c2 == 0.0:
-        # Ring parallel to the plane: every point is lowest; take angle 0 (circle) or the middle
-        # of the arc.
-        angle = start_angle + 0.5 * span if is_arc else 0.0
-    else:
-        angle = math.atan2(-c2, -c1)
-        if is_arc and not arc_angle_in_range(angle, start_angle, span):
-            end_angle = start_angle + span
-            height_start = c1 * math.cos(start_angle) + c2 * math.sin(start_angle)
-            height_end = c1 * math.cos(end_angle) + c2 * math.sin(end_angle)
-            angle = start_angle if height_start <= height_end else end_angle
-    offset = add(scaled(e1, radius * math.cos(angle)), scaled(e2, radius * math.sin(angle)))
-    plane_point(plane_position, normal, add(position, offset), 0.0, 0, stage)
     return 1

@@ -74,6 +74,16 @@ def to_local(position, rotation, world):
 
 
 @njit(cache=True, inline="always")
+def rotate_back(rotation, world):
+    """rotation.T @ world (a direction in the rotation's own frame)"""
+    return (
+        rotation[0][0] * world[0] + rotation[1][0] * world[1] + rotation[2][0] * world[2],
+        rotation[0][1] * world[0] + rotation[1][1] * world[1] + rotation[2][1] * world[2],
+        rotation[0][2] * world[0] + rotation[1][2] * world[1] + rotation[2][2] * world[2],
+    )
+
+
+@njit(cache=True, inline="always")
 def clamp(value, low, high):
     return min(max(value, low), high)
 

@@ -14,17 +14,17 @@ plane-sphere        1   centre height minus radius
 plane-box           8   every corner
 plane-capsule       2   the two end spheres
 plane-cylinder      8   four rim points on each end rim (indices 0, 1: the two lowest)
-plane-circle        1   lowest point of the circle
-plane-arc           1   lowest point of the arc (or its lower end)
+plane-circle        8   6 support points and the 2 deepest points of the ring (kernels/gaps/
+plane-arc           8   ring_faces.py)
 sphere-sphere       1   centre distance minus radii
 box-sphere          1   closest point of the solid box
 capsule-sphere      1   closest point of the axis segment
 cylinder-sphere     1   closest point of the solid cylinder
 circle-cylinder     1   ring against the (infinitely long) lateral surface of a journal
 arc-cylinder        1   the same, restricted to the arc
-rectangle-X         as  plane-X for X = sphere (1), cylinder (8), circle (1), arc (1); a
-disc-X              ..  candidate whose point is off the face, or deeper than its depth, is
-                        dropped
+rectangle-X         as  plane-X for X = sphere (1), cylinder (8), circle (8), arc (8), each
+disc-X              ..  candidate's gap its distance to the face's solid (the edge beyond the
+                        face's bound): never dropped
 circle-bore         1   ring point farthest from the bore axis; dropped outside the bore's
 arc-bore            1   angles or beyond its length
 cylinder-bore       2   one per end of the axial overlap (slot 0 at the bore's -z side);
@@ -56,13 +56,13 @@ CANONICAL_PAIRS = {
     (SHAPE_KINDS[kind_a], SHAPE_KINDS[kind_b]): slots
     for (kind_a, kind_b), slots in gaps.PAIR_SLOTS.items() if slots is not None
 }
-#: Gap [L] the worker hands Siconos for a dropped slot (a candidate off a bounded face, deeper
-#: than its depth, outside a bore's angles or length): far beyond any activation threshold
+#: Gap [L] the worker hands Siconos for a dropped slot (a candidate outside a bore's angles or
+#: length, or deeper than its depth): far beyond any activation threshold
 #: (y + h/2 y' <= ~1e-10 of the smallest feature), so the interaction stays inactive until the
 #: candidate comes back; finite, so Siconos's norms of the outputs stay finite.
 DROPPED_GAP = 1e12
-#: Shape kinds whose pairs can drop candidates (a bounded face, a bore).
-DROPPING_KINDS = (RECTANGLE, DISC, BORE)
+#: Shape kinds whose pairs can drop candidates (a bore): the kernels' DROPPING_KINDS.
+DROPPING_KINDS = tuple(SHAPE_KINDS[kind] for kind in gaps.DROPPING_KINDS)
 
 #: Why the pairs of the shared geometry that the worker does not support are missing.
 NOT_PORTED = {
