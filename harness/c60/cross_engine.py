@@ -7,6 +7,7 @@ Units are the scenes' mm-g-ms: lengths [mm], times [ms], forces [N]; wall times 
 
 from __future__ import annotations
 
+import json
 import math
 import re
 from dataclasses import dataclass, field
@@ -17,6 +18,7 @@ from clearbench.adapters.harness_defaults import C60_ON, C60_TRIP
 from clearbench.adapters.trajectory import Trajectory
 from clearbench.harness.c60 import analysis
 from clearbench.harness.measure import series as metrics
+from clearbench.harness.measure.geometry_check import UNSEEN_FIGURE
 from clearbench.harness.measure.verdicts import judge
 from clearbench.scenarios.c60 import model
 from clearbench.scenarios.library.c60 import SETTLED_AFTER
@@ -54,6 +56,12 @@ class C60RunFigures:
     per joint of the mechanism (J1..J7 and the needle bearing S3), the largest penetration of
     its ring pairs [mm], which is the journal's eccentricity beyond its radial clearance (the
     rings are contacts offset by the clearance, see :mod:`clearbench.scenarios.c60.model`).
+    ``instrument_penetration`` [mm]: the same largest penetration read by the independent
+    geometry instrument when the run was measured (the run's figure
+    ``instrument_penetration_max``, :mod:`clearbench.harness.measure.geometry_check`);
+    ``unseen_penetration`` [mm] and ``unseen_time`` [ms]: how far it exceeds the kernel's
+    figure where it does (0: nowhere), and ``unseen_reason`` the verdict's words (pair,
+    time, both figures). NaN for a run measured before the instrument existed.
     ``stepping_seconds``: wall time of stepping for the whole run [s];
     ``stepping_seconds_per_step`` [s]; ``ratio_to_reference``: stepping wall time per
     simulated ms over the reference engine's at its finest step on the same scene and horizon
@@ -79,6 +87,10 @@ class C60RunFigures:
     penetration_pair: str = ""
     penetration_beyond_rebuild: float = math.nan
     clearance_excess: dict = field(default_factory=dict)
+    instrument_penetration: float = math.nan
+    unseen_penetration: float = math.nan
+    unseen_time: float = math.nan
+    unseen_reason: str = ""
     stepping_seconds: float = math.nan
     stepping_seconds_per_step: float = math.nan
     stepping_seconds_per_simulated_ms: float = math.nan
@@ -168,6 +180,8 @@ def run_figures(row: dict, scene: Scene | None, trajectory: Trajectory | None,
     ``reference_rate``: the reference engine's stepping wall time per simulated ms at its
     finest step on the same scene and horizon [s/ms] (NaN when not run)."""
     rate = float(row.get("stepping_seconds_per_simulated_second", math.nan))
+    figures = json.loads(row.get("metrics") or "{}")
+    unseen = float(figures.get(UNSEEN_FIGURE, math.nan))
     values = dict(
         key=row["key"], scene_name=row["scene_name"],
         label=row.get("label") or f"{row['engine']}[{row['preset']}]",
@@ -177,7 +191,11 @@ def run_figures(row: dict, scene: Scene | None, trajectory: Trajectory | None,
         stepping_seconds=float(row.get("stepping_seconds", math.nan)),
         stepping_seconds_per_step=float(row.get("stepping_seconds_per_step", math.nan)),
         stepping_seconds_per_simulated_ms=rate,
-        ratio_to_reference=rate / reference_rate if reference_rate > 0 else math.nan)
+        ratio_to_reference=rate / reference_rate if reference_rate > 0 else math.nan,
+        instrument_penetration=float(figures.get("instrument_penetration_max", math.nan)),
+        unseen_penetration=unseen,
+        unseen_time=float(figures.get(f"{UNSEEN_FIGURE}_time", math.nan)),
+        unseen_reason=(row.get("verdict_reason") or "") if unseen > 0 else "")
     if scene is not None and trajectory is not None:
         values.update(trajectory_figures(scene, trajectory))
     elif row["status"] in ("ok", "diverged"):

@@ -243,12 +243,15 @@ def print_c60(store, keys: set[str]) -> None:
     frame = store.dataframe(expand_metrics=False)
     runs = collect(store, frame[frame["key"].isin(keys)])
     print(f"\n  {'scene':<9} {'engine':<20} {'dt [ms]':>8} {'status':<10} {'FC-1 [N]':>9} "
-          f"{'creep [mm]':>10} {'open [ms]':>9} {'pen. [mm]':>9} {'beyond [mm]':>11} "
+          f"{'creep [mm]':>10} {'open [ms]':>9} {'pen. [mm]':>9} {'instr. [mm]':>11} "
+          f"{'unseen [mm]':>11} {'beyond [mm]':>11} "
           f"{'wall [s]':>8} {'x ref':>6}")
     for run in runs:
         print(f"  {run.scene_name:<9} {run.label:<20} {run.time_step:>8.3g} {run.status:<10} "
               f"{format_value(run.fc1):>9} {format_value(run.latch_creep):>10} "
               f"{format_value(run.opening):>9} {format_value(run.penetration_max):>9} "
+              f"{format_value(run.instrument_penetration):>11} "
+              f"{format_value(run.unseen_penetration):>11} "
               f"{format_value(run.penetration_beyond_rebuild):>11} "
               f"{format_value(run.stepping_seconds):>8} "
               f"{format_value(run.ratio_to_reference):>6}")

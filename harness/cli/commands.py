@@ -41,6 +41,8 @@ COMMANDS: dict[str, Command] = {
     "regress": Command("regress", "compare a quick suite with the committed baseline"),
     "fclib": Command("fclib", "validate the contact solvers on FCLIB problems (side by side "
                      "with Siconos)"),
+    "check-geometry": Command("check_geometry", "recorded runs' penetration read a second way "
+                              "by the independent geometry instrument, beside the kernel's"),
     "bench": Command("bench", "run a benchmark (prints figures, asserts nothing)"),
     "c60": Command("c60", "C-60 circuit breaker: validation against the published figures"),
     "compile": Command("compile_kernels", "compile the numba kernels into this checkout's "

@@ -12,6 +12,7 @@ input errors of the layers below (:class:`~clearbench.harness.run.engine_choice.
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 from pathlib import Path
@@ -155,7 +156,8 @@ def make_runner(args: argparse.Namespace, store: ResultsStore, total: int) -> Ru
 def progress_line(done: int, total: int, spec: RunSpec, record: RunRecord) -> str:
     """``[37/135] reference[default] pendulum dt=1 ms ✓ pass 1.2 s``: the run, its verdict
     and the wall time of its worker's run phase."""
-    verdict = verdict_text(run_verdict(record.status, record.expectations_passed))
+    verdict = verdict_text(run_verdict(record.status, record.expectations_passed,
+                                       json.loads(getattr(record, "metrics", "") or "{}")))
     step = format_quantity(spec.time_step * TIME_UNITS[spec.scene.units.time], "s")
     return (f"[{done}/{total}] {spec.engine.label} {spec.scene.name} dt={step} {verdict} "
             f"{format_value(record.worker_seconds, 's')}")

@@ -16,6 +16,7 @@ from clearbench.harness.cli.common import (
     make_runner,
     open_store,
 )
+from clearbench.harness.measure.geometry_check import UNSEEN_PENETRATION
 from clearbench.harness.measure.headline import format_value
 from clearbench.harness.measure.units import unit_text
 from clearbench.harness.measure.verdicts import run_verdict, verdict_text
@@ -94,8 +95,10 @@ def print_summary(row: dict, from_store: bool = False, store_path=None,
     origin = " (from the store; --rerun to run again)" if from_store else ""
     print(f"{row['scene_name']}  {row['engine']}[{row['preset']}]  dt = {row['time_step']:g}  "
           f"horizon = {row['horizon']:g}{origin}")
-    verdict = verdict_text(run_verdict(row["status"], row["expectations_passed"]))
-    print(f"  verdict: {verdict}" + (f" — {row['message']}" if row["message"] else ""))
+    figures = json.loads(row["metrics"] or "{}")
+    verdict = run_verdict(row["status"], row["expectations_passed"], figures)
+    reason = row["verdict_reason"] if verdict == UNSEEN_PENETRATION else row["message"]
+    print(f"  verdict: {verdict_text(verdict)}" + (f" — {reason}" if reason else ""))
     if row["engine_status"] != row["status"]:
         print(f"  engine reported: {row['engine_status']} {row['engine_message']}".rstrip())
     print(f"  engine: {row['engine_version']}")
@@ -105,7 +108,6 @@ def print_summary(row: dict, from_store: bool = False, store_path=None,
           f"({format_value(row['stepping_seconds_per_step'], 's')}/step, "
           f"{format_value(row['stepping_seconds_per_simulated_second'], 's')} per simulated "
           "time unit)")
-    figures = json.loads(row["metrics"] or "{}")
     if figures:
         print(f"  metrics (units {units.length}-{units.mass}-{units.time}, force "
               f"{units.force_unit()}; a ratio says what it is of):")

@@ -60,7 +60,8 @@ def run_stability(args: argparse.Namespace) -> int:
         if row["case"] != case:
             case = row["case"]
             print(f"\n{case}: {row['summary']}")
-        verdict = verdict_text(run_verdict(row["status"], row["expectations_passed"]))
+        verdict = verdict_text(run_verdict(row["status"], row["expectations_passed"],
+                                           row["verdict_figures"]))
         scene = scenes.get(row["case"])
         figures = ", ".join(
             f"{METRIC_LABELS.get(n, (n,))[0]} {format_value(v, unit_text(n, scene, short=True))}"

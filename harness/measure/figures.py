@@ -18,6 +18,16 @@ scene is absent.
 ``clearance_eccentricity_max``           largest eccentricity in a clearance joint [L]
 ``clearance_excess_max``                 eccentricity beyond the radial clearance [L]
 ``clearance_excess_relative``            the same over the radial clearance [-]
+``instrument_penetration_max``           the independent instrument's penetration
+                                         (:mod:`.geometry_check`), max over pairs and
+                                         samples [L]
+``instrument_resolution_max``            its largest certified resolution [L]
+``instrument_difference_max``            max |instrument - kernel| penetration [L]
+``instrument_clearance_excess_max``      the instrument's clearance-joint excess [L]
+``unseen_penetration``                   largest excess of the instrument's penetration over
+                                         the kernel's beyond the allowance [L] (> 0: the
+                                         verdict "unseen penetration")
+``unseen_penetration_time``              the time of that state [T]
 ``joint_distance_max``                   ideal-joint anchor separation [L]
 ``joint_angle_max``                      ideal-joint axis / orientation violation [rad]
 ``driver_offset_max``                    driven translation off its prescription [L]
@@ -49,7 +59,10 @@ escapes (:data:`ESCAPE_FACTOR`), when a journal leaves its bore (excess beyond
 than :data:`JOINT_BREAK_FRACTION` of the scene's size, or axes more than
 :data:`JOINT_BREAK_ANGLE` apart; a driven component off its prescription by as much), or
 when a penetration, on a sample or on the straight path between two (swept), exceeds the
-smallest feature of its pair (tunnelling); ``ok`` otherwise.
+smallest feature of its pair (tunnelling); ``ok`` otherwise. An ok run whose
+``unseen_penetration`` is > 0 has the verdict "unseen penetration"
+(:func:`~clearbench.harness.measure.verdicts.run_verdict`), its ``verdict_reason`` naming the
+pair, the time and both figures (:mod:`.geometry_check`).
 """
 
 from __future__ import annotations
@@ -62,6 +75,7 @@ import numpy as np
 
 from clearbench.adapters.energy_guard import ENERGY_EXPECTATIONS
 from clearbench.adapters.trajectory import RunStatus, Trajectory
+from clearbench.harness.measure import geometry_check
 from clearbench.harness.measure import series as metrics
 from clearbench.harness.measure.expectation_figures import ExpectationResult, evaluate
 from clearbench.harness.measure.verdicts import ANALYTIC_ERROR, analytic_error, judgement
@@ -238,6 +252,9 @@ def measure(scene: Scene, trajectory: Trajectory, reference: Trajectory | None =
         _energy(scene, trajectory, out, reasons)
     with out.guard("escape"):
         _escape(scene, trajectory, reasons)
+    unseen = ""
+    with out.guard("geometry check"):
+        unseen = _geometry(scene, trajectory, out)
 
     results: list[dict] = []
     error, source = math.nan, ""
@@ -250,8 +267,27 @@ def measure(scene: Scene, trajectory: Trajectory, reference: Trajectory | None =
     if math.isfinite(error):
         out.put("error", error)
     verdict = RunStatus.DIVERGED if reasons else RunStatus.OK
-    return Measurement(out.figures, tuple(results), verdict, "; ".join(reasons), source,
-                       "; ".join(out.errors))
+    return Measurement(out.figures, tuple(results), verdict, "; ".join(reasons) or unseen,
+                       source, "; ".join(out.errors))
+
+
+def _geometry(scene, trajectory, out: _Collector) -> str:
+    """The independent instrument's figures beside the kernel's (:mod:`.geometry_check`);
+    returns the "unseen penetration" reason ("" when there is none)."""
+    if not scene.expanded.contacts:
+        return ""
+    result = geometry_check.check(scene, trajectory)
+    out.put("instrument_penetration_max", np.nanmax(result.instrument.penetration))
+    out.put("instrument_resolution_max", np.nanmax(result.instrument.resolution))
+    out.put("instrument_difference_max", result.agreement_max)
+    out.put(geometry_check.UNSEEN_FIGURE, result.unseen_max)
+    if scene.clearance_joints:
+        out.put("instrument_clearance_excess_max",
+                np.max(geometry_check.clearance_excess(scene, result)[0]))
+    if result.unseen_max <= 0.0:
+        return ""
+    out.put(f"{geometry_check.UNSEEN_FIGURE}_time", result.times[result.worst()[0]])
+    return result.message(scene.units.length, scene.units.time)
 
 
 def _drift(scene, trajectory, out: _Collector, reasons: list[str]) -> None:

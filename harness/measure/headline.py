@@ -12,6 +12,7 @@ from clearbench.scenarios.scene import Scene
 METRIC_LABELS: dict[str, tuple[str, str]] = {
     "error": ("error", "relative"),
     "penetration_max": ("penetration", "length"),
+    "instrument_penetration_max": ("penetration (instrument)", "length"),
     "clearance_excess_max": ("clearance excess", "length"),
     "joint_distance_max": ("joint gap", "length"),
     "joint_angle_max": ("joint angle", "angle"),
@@ -32,7 +33,7 @@ def scene_metric_names(scene: Scene) -> list[str]:
     if scene.clearance_joints:
         names.append("clearance_excess_max")
     if scene.contacts:
-        names.append("penetration_max")
+        names += ["penetration_max", "instrument_penetration_max"]
     if scene.joints:
         names += ["joint_distance_max", "joint_angle_max"]
     if any(e.kind in ("energy_conserved", "energy_non_increasing") for e in scene.expectations):

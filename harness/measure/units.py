@@ -74,6 +74,9 @@ RUN_FIGURES: dict[str, FigureUnit] = {
     "solver_unconverged_steps": FigureUnit(word="steps"),
     "solver_residual_max": FigureUnit(word="engine's measure"),
     "solver_iterations_mean": FigureUnit(word="iterations"),
+    "instrument_penetration_max": L, "instrument_resolution_max": L,
+    "instrument_difference_max": L, "instrument_clearance_excess_max": L,
+    "unseen_penetration": L, "unseen_penetration_time": T,
 }
 
 _STICK = {"displacement": L, "creep_rate": V}

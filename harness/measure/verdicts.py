@@ -5,17 +5,19 @@ matrix and the CLI show (:func:`run_verdict`, from the run's status and its expe
 
 The verdict of a run (:data:`VERDICTS`: label -> symbol, colour, meaning):
 
-===============  ======  ===============================================================
-verdict          symbol  when
-===============  ======  ===============================================================
-pass             ✓       finished (status ok) and every expectation judged passed
-physics failed   ✗       finished, but an expectation of the scene failed
-no check         ○       finished, and the scene has no expectation that could be judged
-diverged         ↯       NaN, energy gain, escape, tunnelling, a joint or driver broken
-crashed          ☠       the engine or its worker died or raised
-timed out        ⌛      the wall-clock limit was reached
-unsupported      ∅       the engine cannot represent the scene (it says why)
-===============  ======  ===============================================================
+==================  ======  ===============================================================
+verdict             symbol  when
+==================  ======  ===============================================================
+pass                ✓       finished (status ok) and every expectation judged passed
+physics failed      ✗       finished, but an expectation of the scene failed
+unseen penetration  ◐       finished, but the geometry instrument witnesses a penetration the
+                            kernel's figure misses (:mod:`.geometry_check`)
+no check            ○       finished, and the scene has no expectation that could be judged
+diverged            ↯       NaN, energy gain, escape, tunnelling, a joint or driver broken
+crashed             ☠       the engine or its worker died or raised
+timed out           ⌛      the wall-clock limit was reached
+unsupported         ∅       the engine cannot represent the scene (it says why)
+==================  ======  ===============================================================
 
 :func:`clearbench.harness.measure.expectation_figures.evaluate` states figures, not verdicts:
 what is acceptable depends on the use. The harness's criteria, each relative to a scale of the
@@ -382,6 +384,9 @@ VERDICTS: dict[str, VerdictStyle] = {
     "pass": VerdictStyle("✓", "#cde9d0", "finished; every expectation of the scene passed"),
     "physics failed": VerdictStyle("✗", "#ffd98a", "finished, but an expectation of the scene "
                                    "failed (wrong physics)"),
+    "unseen penetration": VerdictStyle("◐", "#f7c6a3", "finished, but the independent geometry "
+                                       "instrument witnesses a penetration the kernel's figure "
+                                       "does not show (harness/measure/geometry_check.py)"),
     "no check": VerdictStyle("○", "#f2f2f2", "finished; no expectation of the scene could be "
                              "judged"),
     "diverged": VerdictStyle("↯", "#f2a08f", "stopped or judged broken: NaN, energy gain, "
@@ -397,13 +402,17 @@ _STATUS_VERDICTS = {"diverged": "diverged", "crashed": "crashed", "timed_out": "
                     "unsupported": "unsupported"}
 
 
-def run_verdict(status: str, expectations_passed) -> str:
+def run_verdict(status: str, expectations_passed, figures: dict | None = None) -> str:
     """The verdict of a run (a key of :data:`VERDICTS`) from its stored status and its
-    ``expectations_passed`` (1 all judged passed, 0 one failed, None or NaN none judged)."""
+    ``expectations_passed`` (1 all judged passed, 0 one failed, None or NaN none judged);
+    ``figures`` (the run's stored figures): an ok run with an ``unseen_penetration`` > 0 is
+    "unseen penetration" (the run-wide geometry check)."""
     if status != "ok":
         if status not in _STATUS_VERDICTS:
             raise ValueError(f"unknown run status {status!r}")
         return _STATUS_VERDICTS[status]
+    if figures and (figures.get("unseen_penetration") or 0.0) > 0.0:
+        return "unseen penetration"
     if expectations_passed is None or (isinstance(expectations_passed, float)
                                        and math.isnan(expectations_passed)):
         return "no check"

@@ -159,14 +159,16 @@ def _cell(row: dict | None, scene: Scene | None) -> tuple[str, str, str]:
     name, value = headline(scene, figures) if scene is not None else ("", math.nan)
     label = METRIC_LABELS.get(name, (name, ""))[0]
     text = f"{label} {format_value(value, unit_text(name, scene, short=True))}" if name else ""
-    return run_verdict(row["status"], row.get("expectations_passed")), text, _run_title(row)
+    return (run_verdict(row["status"], row.get("expectations_passed"), figures), text,
+            _run_title(row))
 
 
 def _run_title(row) -> str:
     """The run's message and its failed expectations (a verdict cell's title)."""
     failed = [r["name"] for r in json.loads(row.get("expectations") or "[]")
               if r.get("passed") is False]
-    return "; ".join(filter(None, [row.get("message") or "",
+    unseen = (row.get("verdict_reason") or "") if row.get("status") == "ok" else ""
+    return "; ".join(filter(None, [row.get("message") or "", unseen,
                                    f"failed: {', '.join(failed)}" if failed else ""]))
 
 
@@ -244,7 +246,8 @@ def _verdict_body(verdict: str, text: str) -> tuple[str, str]:
 def _run_verdict_td(run) -> str:
     """A per-scene table's verdict cell: the run's verdict (status and expectations together,
     as in the overview), its colour, and the message and failed expectations as its title."""
-    colour, body = _verdict_body(run_verdict(run["status"], run["expectations_passed"]), "")
+    colour, body = _verdict_body(run_verdict(run["status"], run["expectations_passed"],
+                                             json.loads(run["metrics"] or "{}")), "")
     return f"<td style='background:{colour}' title='{_esc(_run_title(run))}'>{body}</td>"
 
 
@@ -515,7 +518,8 @@ def render_markdown(data: ReportData, figure_files: dict, c60_figure_files: dict
         for _, run in section.runs.sort_values(["label", "time_step"]).iterrows():
             figures = json.loads(run["metrics"] or "{}")
             role = " (fine ref)" if str(run["campaign"]).endswith(FINE_SUFFIX) else ""
-            verdict = verdict_text(run_verdict(run["status"], run["expectations_passed"]))
+            verdict = verdict_text(run_verdict(run["status"], run["expectations_passed"],
+                                               figures))
             lines.append(f"| {run['label']}{role} | {run['time_step']:.3g} | {verdict} | "
                          + " | ".join(format_value(figures.get(c)) for c in columns)
                          + f" | {format_value(run['stepping_seconds_per_step'], 's')} |")

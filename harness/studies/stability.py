@@ -47,6 +47,7 @@ def stability_rows(frame, specs: Sequence[RunSpec]) -> list[dict]:
             "reason": row["message"],
             "expectations_passed": row["expectations_passed"],
             "metrics": {n: figures[n] for n in names},
+            "verdict_figures": figures,
             "stepping_seconds_per_step": row["stepping_seconds_per_step"],
         })
     return rows
