@@ -58,7 +58,8 @@ def run_line(scene_name: str, variant: str, time_step: float, clearance: float |
             f"deg strike={events.strike:.3f} release={events.release:.3f} "
             f"opening={events.opening:.3f} ms penetration={penetration:.3e} mm "
             f"unconverged={count} {unconverged[:5]} projections={len(projections)} "
-            f"{projections[:5]} steps={trajectory.steps} wall={wall:.0f} s")
+            f"{projections[:5]} iterations={np.mean(trajectory.solver_iterations):.1f} "
+            f"steps={trajectory.steps} wall={wall:.0f} s")
 
 
 def main() -> None:

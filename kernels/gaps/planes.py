@@ -3,6 +3,8 @@ shape-frame z = 0; its +z axis is the normal (from A toward B)."""
 
 from __future__ import annotations
 
+import math
+
 from clearbench.kernels.gaps.staging import stage_contact
 from clearbench.kernels.gaps.vectors import (
     add,
@@ -10,7 +12,6 @@ from clearbench.kernels.gaps.vectors import (
     column_of,
     cross,
     dot,
-    norm,
     scaled,
     sub,
     to_world,
@@ -58,15 +59,23 @@ def plane_capsule(plane_position, plane_rotation, position, rotation, radius, ha
 @njit(cache=True)
 def lowest_direction(normal, rotation):
     """Unit vector in the shape's xy-plane most opposed to ``normal`` (the shape's x axis when
-    that plane is parallel to the contact plane), and ``z x lowest``, 90 degrees further."""
-    axis = column_of(rotation, 2)
-    down = axpy(-dot(normal, axis), axis, normal)
-    length = norm(down)
+    that plane is parallel to the contact plane), and ``z x lowest``, 90 degrees further.
+
+    Built from the normal's components along the shape's x and y axes, so it lies in that
+    plane to round-off even when the axis is parallel to the normal: there the components are
+    round-off, their direction arbitrary, but every rim point is then as low as any other (a
+    projection ``normal - (normal . z) z`` would leave a round-off vector along the axis,
+    whose normalised direction puts the "rim" points a radius off the rim)."""
+    e1 = column_of(rotation, 0)
+    e2 = column_of(rotation, 1)
+    along_1 = dot(normal, e1)
+    along_2 = dot(normal, e2)
+    length = math.hypot(along_1, along_2)
     if length > 0.0:
-        lowest = scaled(down, -1.0 / length)
+        lowest = add(scaled(e1, -along_1 / length), scaled(e2, -along_2 / length))
     else:
-        lowest = column_of(rotation, 0)
-    return lowest, cross(axis, lowest)
+        lowest = e1
+    return lowest, cross(column_of(rotation, 2), lowest)
 
 
 @njit(cache=True, inline="always")
