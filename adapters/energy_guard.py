@@ -13,14 +13,12 @@ from __future__ import annotations
 import numpy as np
 
 from clearbench.scenarios.bodies import Motion
+from clearbench.scenarios.expectation_kinds import energy_may_not_grow
 from clearbench.scenarios.features import WORK_FEATURES
 from clearbench.scenarios.scales import largest_shape_dimension
 from clearbench.scenarios.scene import Scene
 
-__all__ = ["ENERGY_EXPECTATIONS", "EnergyGuard"]
-
-#: Expectation kinds under which the energy of the scene may not grow.
-ENERGY_EXPECTATIONS = ("energy_non_increasing", "energy_conserved")
+__all__ = ["EnergyGuard"]
 
 
 class EnergyGuard:
@@ -65,8 +63,7 @@ class EnergyGuard:
         self.size_scale = float(mass) * gravity * largest_shape_dimension(scene)
 
     def _applies(self, scene: Scene, work_features: tuple) -> bool:
-        kinds = {e.kind for e in scene.expectations}
-        if not kinds & set(ENERGY_EXPECTATIONS):
+        if not any(energy_may_not_grow(e.kind) for e in scene.expectations):
             self.notes.append("energy guard off: no energy expectation")
             return False
         work = sorted(set(work_features) & scene.features)

@@ -20,7 +20,8 @@ from clearbench.scenarios.bodies import Motion
 from clearbench.scenarios.loads import LinearSpringDamper, TorsionalSpringDamper
 from clearbench.scenarios.scene import Scene
 
-__all__ = ["Energy", "SpringPoints", "mechanical_energy", "rigid_spring_points"]
+__all__ = ["Energy", "SpringPoints", "dissipative_elements", "mechanical_energy",
+           "rigid_spring_points"]
 
 #: ``points(load) -> (point_a, point_b)``: the world positions (..., 3) [L] of a linear
 #: spring's two attachment points in the state measured.
@@ -119,3 +120,24 @@ def rigid_spring_points(scene: Scene, origins: np.ndarray, rotations: np.ndarray
                 origins[b] + rotations[b] @ np.asarray(load.point_b, dtype=float))
 
     return points
+
+
+def dissipative_elements(scene: Scene) -> tuple[str, ...]:
+    """What in ``scene`` can take mechanical energy, in words (``"contact ball_floor:
+    restitution 0"``, ``"spring tie: damping 0.5"``): every contact pair, explicit or generated
+    by a clearance joint, with friction or with restitution e < 1 (an impact on it loses
+    (1 - e^2) of its normal kinetic energy, a slip rubs), and every spring-damper with
+    damping. Empty: the scene conserves energy wherever its energy balance is complete (no
+    driver or working load, :data:`~clearbench.scenarios.features.WORK_FEATURES`): ideal
+    joints, gravity and undamped springs exchange energy without loss, and elastic
+    frictionless impacts (Newton, e = 1) give back what they take."""
+    found = []
+    for contact in scene.all_contacts:
+        if contact.friction > 0:
+            found.append(f"contact {contact.name}: friction {contact.friction:g}")
+        elif contact.restitution < 1:
+            found.append(f"contact {contact.name}: restitution {contact.restitution:g}")
+    for load in scene.loads:
+        if isinstance(load, LinearSpringDamper | TorsionalSpringDamper) and load.damping > 0:
+            found.append(f"spring {load.name}: damping {load.damping:g}")
+    return tuple(found)

@@ -34,6 +34,7 @@ from clearbench.scenarios.joints import ClearanceRevoluteJoint, Joint
 from clearbench.scenarios.loads import Load, Moment, PointForce
 from clearbench.scenarios.outputs import ContactForce, Output
 from clearbench.scenarios.rescaling import rescale_element
+from clearbench.scenarios.tags import check_tags
 from clearbench.scenarios.units import UnitSystem
 from clearbench.scenarios.validation import (
     ACCELERATION,
@@ -45,6 +46,9 @@ from clearbench.scenarios.validation import (
     dim,
 )
 
+#: The name of a scene built without one (a library factory's, before the registry names it).
+UNNAMED = "unnamed"
+
 
 @dataclass(frozen=True)
 class Scene:
@@ -53,7 +57,8 @@ class Scene:
     Parameters
     ----------
     name : str
-        Registry name.
+        The scene's name; a library scene is named by the registry
+        (:func:`~clearbench.scenarios.registry.register`), so its factory leaves it out.
     description : str
         One or two sentences for listings and reports.
     units : UnitSystem
@@ -67,10 +72,11 @@ class Scene:
     bodies, joints, clearance_joints, contacts, loads, drivers, outputs, expectations : tuples
         The elements; names unique within each collection.
     tags : tuple of str
-        Registry tags (``smoke``, ``analytic``, ``clearance``, ``c60``, ...).
+        Tags of :data:`clearbench.scenarios.tags.TAGS` (``smoke``, ``analytic``, ``c60``, ...);
+        a library scene's are its registry entry's.
     """
 
-    name: str
+    name: str = UNNAMED
     description: str = ""
     units: UnitSystem = UnitSystem()
     gravity: tuple = field(default=(0.0, 0.0, -9.81), metadata=dim(ACCELERATION))
@@ -100,8 +106,7 @@ class Scene:
             "expectations", "tags",
         ):
             object.__setattr__(self, collection, tuple(getattr(self, collection)))
-        for index, tag in enumerate(self.tags):
-            check_name(f"tags[{index}]", tag)
+        check_tags("tags", self.tags)
         self._check_unique_names()
         self._check_references()
 
@@ -194,6 +199,7 @@ class Scene:
             if expectation.output is not None and expectation.output not in output_names:
                 raise SceneError(f"expectations[{expectation.name!r}].output", expectation.output,
                                  f"unknown output; outputs: {sorted(output_names)}")
+            EXPECTATION_KINDS[expectation.kind].check_in_scene(self, expectation)
 
     # ------------------------------------------------------------------ access
     def body(self, name: str) -> Body:
@@ -322,7 +328,7 @@ class Scene:
         for expectation in scene.expectations:
             spec = EXPECTATION_KINDS[expectation.kind]
             in_output_unit = [k for k in expectation.parameters
-                              if spec.parameters[k] == OUTPUT_DIMENSION]
+                              if spec.parameters[k].dimension == OUTPUT_DIMENSION]
             if in_output_unit:
                 factor = self.units.factor_to(units, dimensions[expectation.output])
                 parameters = dict(expectation.parameters)

@@ -100,6 +100,8 @@ def scene_from_dict(data: Any) -> Scene:
     """Build and validate a :class:`Scene` from its plain-dict form."""
     if not isinstance(data, dict):
         raise SceneError("scene", data, "must be a table (mapping)")
+    if "name" not in data:  # a scene file names its scene (Scene's default is the library's)
+        raise SceneError("scene.name", None, "missing required field of Scene")
     data = dict(data)
     units_data = data.pop("units", {})
     if not isinstance(units_data, dict):

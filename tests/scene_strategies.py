@@ -160,5 +160,5 @@ def scenes(draw):
         name="generated", description="hypothesis scene", units=units, gravity=draw(vector3),
         horizon=horizon, time_step=horizon * draw(st.floats(1e-6, 1.0)), bodies=tuple(bodies),
         joints=tuple(joints), clearance_joints=tuple(clearance), contacts=tuple(contacts),
-        loads=tuple(loads), drivers=tuple(drivers), tags=("generated",),
+        loads=tuple(loads), drivers=tuple(drivers),
     )

@@ -3,6 +3,7 @@ the report's C-60 section rendered from realistic figures, the demo plan, the en
 
 from __future__ import annotations
 
+import html
 import math
 
 import numpy as np
@@ -158,3 +159,22 @@ def test_each_engine_keeps_one_style():
     assert engine_style("mujoco[tuned]").marker != engine_style("mujoco[default]").marker
     assert engine_style("mujoco[tuned] dt=0.001") == engine_style("mujoco[tuned]")
     assert engine_style("mine[odd]") == engine_style("mine[odd]")   # stable for any label
+
+
+def test_the_instrument_figure_stands_beside_the_kernels():
+    """A run's stored instrument figures reach the C-60 table: the largest penetration read
+    by the independent instrument, and UNSEEN with the verdict's words where it saw more."""
+    from clearbench.harness.c60.cross_engine import run_figures
+
+    reason = ("unseen penetration: Hook_Tbar_C4_4 at t = 7.37 ms: the instrument witnesses "
+              "0.0685 mm, the kernel's figure is 0 mm")
+    row = {"key": "k", "scene_name": "c60-trip", "engine": "reference", "preset": "default",
+           "time_step": 1e-3, "horizon": 8.5, "status": "ok", "verdict_reason": reason,
+           "metrics": '{"instrument_penetration_max": 0.0685, "unseen_penetration": 0.0685, '
+                      '"unseen_penetration_time": 7.37}'}
+    run = run_figures(row, None, None)
+    assert (run.instrument_penetration, run.unseen_time) == (0.0685, 7.37)
+    section = C60Section([*RUNS, run], [], {}, {})
+    markdown = "\n".join(section_markdown(section, "f.png"))
+    assert "0.0685 UNSEEN 0.0685 more than the kernel's at 7.37 ms" in markdown
+    assert html.escape(reason) in section_html(section)  # among the run messages

@@ -13,7 +13,7 @@ import pytest
 
 from clearbench.harness.cli.run import print_summary
 from clearbench.harness.measure.figures import measure
-from clearbench.harness.measure.verdicts import ENERGY_GROWTH_ALLOWANCE
+from clearbench.harness.measure.kinds.invariants import ENERGY_GROWTH_ALLOWANCE
 from clearbench.scenarios import analytic
 from clearbench.scenarios.expectations import Expectation
 from clearbench.scenarios.library import get_scene

@@ -76,7 +76,7 @@ def test_unseen_penetration_fails_the_run_by_name(blind_kernel):
     run = trajectory(scene, [ABOVE, DIPPING, OVER_THE_EDGE, ABOVE])
     measured = figures.measure(scene, run)
     unseen = measured.figures[geometry_check.UNSEEN_FIGURE]
-    # 0.1 m deep by the hand computation, less the allowance (resolution 5e-6 m, round-off
+    # 0.1 m deep by the hand computation, less the allowance (resolution 5e-7 m, round-off
     # 1e-9 of the scene's size): at least 0.0999.
     assert unseen == pytest.approx(0.1, abs=1e-4)
     assert measured.figures["unseen_penetration_time"] == pytest.approx(0.02)
@@ -94,9 +94,9 @@ def test_agreeing_figures_pass():
     run = trajectory(scene, [ABOVE, DIPPING, ABOVE])
     measured = figures.measure(scene, run)
     assert measured.figures[geometry_check.UNSEEN_FIGURE] == 0.0
-    # Both within the pair's resolution, 1e-5 of its smallest length (the ring's 0.5 m).
-    assert measured.figures["instrument_penetration_max"] == pytest.approx(0.01, abs=5e-6)
-    assert measured.figures["instrument_difference_max"] <= 5e-6
+    # Both within the pair's resolution, 1e-6 of its smallest length (the ring's 0.5 m).
+    assert measured.figures["instrument_penetration_max"] == pytest.approx(0.01, abs=5e-7)
+    assert measured.figures["instrument_difference_max"] <= 5e-7
     assert run_verdict(measured.verdict.value, 1, measured.figures) == "pass"
     result = geometry_check.check(scene, run)
     assert result.agrees and result.unseen_intervals() == {}

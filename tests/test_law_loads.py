@@ -48,7 +48,7 @@ def lever_pendulum(offset: float = 0.3, stiffness: float = 2.0, lever: float = 0
         "lever-pendulum", gravity=(0.0, 0.0, 0.0), horizon=2.0, time_step=1e-3,
         bodies=(Body("ground", motion=Motion.FIXED), body),
         joints=(RevoluteJoint("pivot", body_a="ground", body_b="arm", axis=Z),),
-        loads=(law,), tags=("test",),
+        loads=(law,),
     )
 
 
@@ -118,7 +118,7 @@ def test_distance_law_along_a_body_axis_oscillates_about_the_rest_length():
                 Body("slider", mass=2.0, position=(1.1, 0.0, 0.0))),
         joints=(PrismaticJoint("rail", body_a="ground", body_b="slider", anchor=(1.1, 0, 0),
                                axis=(1.0, 0.0, 0.0)),),
-        loads=(law,), tags=("test",),
+        loads=(law,),
     )
     trajectory = ENGINE.run(scene, RunSettings())
     x = trajectory.positions[:, 1, 0]
@@ -150,7 +150,6 @@ def test_law_loads_round_trip_and_rescale():
             applications=(LoadApplication("plate", "force", (-1.0, 0.0, 0.0), "body",
                                           (0.19, 9.0, -7.6)),
                           LoadApplication("plate", "moment", Z, "world", lever=2.0)))),
-        tags=("test",),
     )
     assert {"angle_law_loads", "distance_law_loads"} <= scene.features
     assert scene_from_dict(scene_to_dict(scene)) == scene

@@ -30,8 +30,7 @@ def test_oblique_frictional_impact_with_an_offset_conserves_angular_momentum():
     scene = Scene("offset-impact", gravity=(0.0, 0.0, 0.0), horizon=0.5, time_step=1e-3,
                   bodies=(a, b),
                   contacts=(ContactPair("ab", body_a="a", shape_a="s", body_b="b", shape_b="s",
-                                        friction=0.5, offset=0.05),),
-                  tags=("test",))
+                                        friction=0.5, offset=0.05),))
     # theta = 1 without projection: x_{k+1} = x_k + h v_{k+1}, so the discrete angular momentum
     # sum m x x v + R J omega changes only by the moments of the impulses about the points
     # where they act (with theta = 1/2 it also changes by h/2 v_k x v_{k+1} at an impact, and
@@ -78,8 +77,7 @@ def test_a_contact_that_slides_off_a_bounded_face_is_dropped_not_projected():
                      position=(0.45, 0.0, 0.1), velocity=(1.0, 0.0, 0.0),
                      shapes=(Sphere("s", radius=0.1),))),
         contacts=(ContactPair("ball_top", body_a="table", shape_a="top", body_b="ball",
-                              shape_b="s", friction=0.0),),
-        tags=("test",))
+                              shape_b="s", friction=0.0),))
     trajectory = create().run(scene, RunSettings())
     assert trajectory.status.value == "ok", trajectory.message
     x = trajectory.positions[:, 1]

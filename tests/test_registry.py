@@ -61,6 +61,18 @@ def test_factories_take_parameters():
     assert scene.clearance_joints[0].radial_clearance == 1e-6
 
 
+def test_a_factory_called_directly_takes_its_parameters_by_position_or_name():
+    """The registry's wrapper keeps the factory's signature: ``incline_stick(10.0, 0.3)`` and
+    ``incline_stick(angle_degrees=10.0, friction=0.3)`` build the same scene, named."""
+    from clearbench.scenarios.library.basic import incline_stick
+
+    by_position = incline_stick(12.0, 0.4)
+    by_name = incline_stick(angle_degrees=12.0, friction=0.4)
+    assert by_position == by_name
+    assert by_position.name == "incline-stick"
+    assert by_position.contacts[0].friction == 0.4
+
+
 def test_unknown_scene_names_the_known_ones():
     with pytest.raises(KeyError, match="bouncing-ball-e0.5"):
         get_scene("no-such-scene")

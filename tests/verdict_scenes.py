@@ -1,17 +1,20 @@
 """Scenes written for the verdict tests (not in the library): a row of three balls with
-elastic impacts on a floor, and a planar linkage whose driven ends pull a joint apart.
+elastic impacts (on a floor, and in space), a planar linkage whose driven ends pull a joint
+apart, a branched pendulum tree, and a four-bar linkage with a clearance joint.
 
 SI units (m, kg, s).
 """
 
 from __future__ import annotations
 
+import math
+
 from clearbench.scenarios.bodies import Body, Motion
 from clearbench.scenarios.contacts import ContactPair
 from clearbench.scenarios.drivers import Driver
 from clearbench.scenarios.expectations import Expectation
-from clearbench.scenarios.inertia import diagonal, solid_sphere
-from clearbench.scenarios.joints import PrismaticJoint, RevoluteJoint
+from clearbench.scenarios.inertia import diagonal, solid_box, solid_sphere
+from clearbench.scenarios.joints import ClearanceRevoluteJoint, PrismaticJoint, RevoluteJoint
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.shapes import Plane, Sphere
 
@@ -117,4 +120,63 @@ def branched_tree(arm: float = 0.2) -> Scene:
             RevoluteJoint("left_tip", body_a="left", body_b="tip",
                           anchor=(2.0 * arm, 0.0, 0.0), axis=y_axis),
         ),
+    )
+
+
+def elastic_row_in_space(speed: float = 1.0, radius: float = 0.05, mass: float = 0.2) -> Scene:
+    """The three-ball row without floor or gravity: every contact elastic (e = 1) and
+    frictionless, nothing else acting, so the scene conserves energy by its content alone.
+    Rigid impacts hand the first ball's momentum to the third (0, 0, ``speed``); a scheme
+    that ends the impacts plastic leaves the three together at ``speed`` / 3, a third of the
+    kinetic energy."""
+    balls = tuple(Body(f"ball{index}", mass=mass, inertia=solid_sphere(mass, radius),
+                       position=(x, 0.0, 0.0),
+                       velocity=(speed if index == 0 else 0.0, 0.0, 0.0),
+                       shapes=(Sphere("sphere", radius=radius),))
+                  for index, x in enumerate((-4.0 * radius, 0.0, 2.0 * radius)))
+    contacts = tuple(ContactPair(f"{a.name}_{b.name}", body_a=a.name, shape_a="sphere",
+                                 body_b=b.name, shape_b="sphere", restitution=1.0)
+                     for a, b in zip(balls, balls[1:], strict=False))
+    return Scene(
+        name="elastic-row-in-space",
+        description="Three balls in a row without gravity, elastic frictionless impacts: the "
+        "first one's momentum passes to the third, the energy is conserved.",
+        gravity=(0.0, 0.0, 0.0), horizon=0.3, time_step=1e-3, bodies=balls,
+        contacts=contacts,
+        expectations=(Expectation("no_penetration", kind="no_penetration"),),
+    )
+
+
+def clearance_four_bar(radial_clearance: float = 1e-4) -> Scene:
+    """A four-bar linkage in the xz-plane released at rest under gravity: ground pivots A
+    (0, 0, 0) and D (0.4, 0, 0) m, crank A-B (0.2 m at 60 degrees), coupler B-C, rocker D-C,
+    revolute axes along y. A, B and D are ideal joints; C (coupler to rocker) is a clearance
+    joint (journal radius 10 mm, ``radial_clearance`` [m]): its journal and bearing are on two
+    moving bodies of one kinematic tree."""
+    a, b, c, d = (0.0, 0.0, 0.0), (0.1, 0.0, 0.1732), (0.45, 0.0, 0.28), (0.4, 0.0, 0.0)
+    y_axis = (0.0, 1.0, 0.0)
+
+    def link(name: str, start: tuple, end: tuple, mass: float = 1.0) -> Body:
+        # A bar of square section 40 mm from start to end, its frame at its middle, x along it.
+        dx, dz = end[0] - start[0], end[2] - start[2]
+        length, angle = (dx * dx + dz * dz) ** 0.5, -math.atan2(dz, dx)
+        return Body(name, mass=mass, inertia=solid_box(mass, (0.5 * length, 0.02, 0.02)),
+                    position=tuple(0.5 * (p + q) for p, q in zip(start, end, strict=True)),
+                    orientation=(math.cos(0.5 * angle), 0.0, math.sin(0.5 * angle), 0.0))
+
+    return Scene(
+        name="clearance-four-bar",
+        description="A four-bar linkage falling under gravity from rest, its coupler-rocker "
+        "pin a clearance joint.",
+        horizon=0.5, time_step=1e-3,
+        bodies=(Body("ground", motion=Motion.FIXED), link("crank", a, b),
+                link("coupler", b, c), link("rocker", d, c)),
+        joints=(RevoluteJoint("A", body_a="ground", body_b="crank", anchor=a, axis=y_axis),
+                RevoluteJoint("B", body_a="crank", body_b="coupler", anchor=b, axis=y_axis),
+                RevoluteJoint("D", body_a="ground", body_b="rocker", anchor=d, axis=y_axis)),
+        clearance_joints=(ClearanceRevoluteJoint(
+            "C", journal_body="coupler", bearing_body="rocker", anchor=c, axis=y_axis,
+            journal_radius=0.01, radial_clearance=radial_clearance, bearing_length=0.02,
+            axial_clearance=1e-4, thrust_radius=0.015, friction=0.1, restitution=0.0),),
+        expectations=(Expectation("no_penetration", kind="no_penetration"),),
     )

@@ -11,7 +11,9 @@ The scene is expected in the model's internal units (SI by default, see :mod:`.e
   velocities and motors.
 - Collision objects: one per group of pieces of each side of each contact pair
   (:mod:`.geometry`); every default collision is switched off (group and mask 0) and each
-  pair's objects are enabled against each other with ``setCollisionFilterPair``. Side A carries
+  pair's objects are enabled against each other with ``setCollisionFilterPair``; a multibody
+  is created with self-collision on, so that the pairs between two of its links collide (a
+  clearance joint inside a linkage, whose journal and bearing are links of one tree). Side A carries
   the pair's mu and e, side B 1 and 1 (PyBullet multiplies them).
 - Joints and drivers (:mod:`.topology`): multibody links whose link frame sits at the joint
   anchor with the body's orientation; collision objects are extra links welded with
@@ -340,7 +342,11 @@ def _build_tree(client, scene, settings, tree: TreePlan, topology, body_poses, g
         linkOrientations=orientations, linkInertialFramePositions=inertial_positions,
         linkInertialFrameOrientations=inertial_orientations, linkParentIndices=parents,
         linkJointTypes=types, linkJointAxis=axes, useMaximalCoordinates=False,
-        physicsClientId=client)
+        # Links of one multibody never collide without it, whatever setCollisionFilterPair
+        # enables (btMultiBodyLinkCollider::checkCollideWithOverride): the journal and the
+        # bearing of a clearance joint between two links of one tree carried 0 N and the
+        # journal left its bore. Only the pairs enabled below collide (every mask is 0).
+        flags=pb.URDF_USE_SELF_COLLISION, physicsClientId=client)
     # PyBullet renumbers the links depth-first: every index planned above is a creation index.
     index_of = _link_indices(client, uid)
     pending = [(name, index_of[k], moments, inertial) for name, k, moments, inertial in pending]

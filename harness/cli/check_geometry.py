@@ -108,8 +108,8 @@ def _runs(args):
             raise UserError(f"{key}: neither a trajectory file nor a run of the store "
                             f"{store.directory}")
         trajectory = store.load_trajectory(key)
-        if trajectory is None:
-            print(f"{key}: no trajectory stored (status {row['status']}), skipped")
+        if trajectory is None or not len(trajectory.times):
+            print(f"{key}: no recorded state stored (status {row['status']}), skipped")
             continue
         label = (f"{row['scene_name']} {row['engine']}[{row['preset']}] "
                  f"dt={row['time_step']:g} ({key})")

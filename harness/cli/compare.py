@@ -31,19 +31,18 @@ from clearbench.harness.studies.sweep import (
     plan_sweep,
 )
 from clearbench.scenarios.library import get_entry, scene_names
+from clearbench.scenarios.tags import DEFAULT_COMPARISON, STIFF
 
-#: Scenes of the default comparison: the library scenes with these tags.
-COMPARE_TAGS = ("smoke", "analytic")
 #: Default ladder of the comparison: the comfortable step and its half.
 COMPARE_LADDER = "1x,0.5x"
 
 
 def compare_scenes() -> list[str]:
-    """Registered scenes with a tag of :data:`COMPARE_TAGS`, not in the stiff suite."""
+    """Registered scenes with a tag of :data:`DEFAULT_COMPARISON`, not in the stiff suite."""
     chosen = []
-    for tag in COMPARE_TAGS:
+    for tag in DEFAULT_COMPARISON:
         chosen += [n for n in scene_names(tag) if n not in chosen]
-    stiff = set(scene_names("stiff"))
+    stiff = set(scene_names(STIFF))
     return [n for n in chosen if n not in stiff]
 
 
@@ -61,7 +60,7 @@ def register(subparsers) -> None:
         "compare", help=command_help("compare"),
         description="Run the default comparison: every available engine (reference, and "
         "MuJoCo etc. where available) on the library scenes tagged "
-        f"{' or '.join(COMPARE_TAGS)} at their comfortable step and a short ladder "
+        f"{' or '.join(DEFAULT_COMPARISON)} at their comfortable step and a short ladder "
         f"({COMPARE_LADDER}), optionally the stiff suite, then write the report. Runs already "
         "in the store are reused.",
     )
@@ -88,7 +87,7 @@ def add_compare_options(parser: argparse.ArgumentParser) -> None:
                       help="engines (default: every available engine, default preset)")
     parser.add_argument("--scenes", nargs="+", default=None, metavar="SCENE",
                         help="scenes (default: the library scenes tagged "
-                        f"{', '.join(COMPARE_TAGS)})")
+                        f"{', '.join(DEFAULT_COMPARISON)})")
     parser.add_argument("--dt", default=COMPARE_LADDER, metavar="LADDER",
                         help=f"time-step ladder (default {COMPARE_LADDER})")
     parser.add_argument("--stability", action="store_true",

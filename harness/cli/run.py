@@ -97,7 +97,8 @@ def print_summary(row: dict, from_store: bool = False, store_path=None,
           f"horizon = {row['horizon']:g}{origin}")
     figures = json.loads(row["metrics"] or "{}")
     verdict = run_verdict(row["status"], row["expectations_passed"], figures)
-    reason = row["verdict_reason"] if verdict == UNSEEN_PENETRATION else row["message"]
+    reason = (row["verdict_reason"].removeprefix(f"{UNSEEN_PENETRATION}: ")
+              if verdict == UNSEEN_PENETRATION else row["message"])
     print(f"  verdict: {verdict_text(verdict)}" + (f" — {reason}" if reason else ""))
     if row["engine_status"] != row["status"]:
         print(f"  engine reported: {row['engine_status']} {row['engine_message']}".rstrip())

@@ -17,18 +17,18 @@ from clearbench.harness.measure.headline import METRIC_LABELS, format_value
 from clearbench.harness.measure.units import unit_text
 from clearbench.harness.measure.verdicts import run_verdict, verdict_text
 from clearbench.harness.studies.stability import (
-    STIFF_TAG,
     available_engines,
     plan_stability,
     stability_rows,
 )
 from clearbench.harness.studies.sweep import resolve_engines
+from clearbench.scenarios.tags import STIFF
 
 
 def register(subparsers) -> None:
     parser = subparsers.add_parser(
         "stability", help=command_help("stability"),
-        description="Run every scene tagged 'stiff' (tight clearances, mass ratio 1e4, stiff "
+        description=f"Run every scene tagged {STIFF!r} (tight clearances, mass ratio 1e4, stiff "
         "springs, 10x steps, tunnelling impacts, mu = 2, e = 1, 100+ contacts, millimetre parts "
         "in SI units) in each engine at the case's own step, and print each engine's verdict "
         "(pass / physics failed / diverged / crashed / timed out / unsupported) with the metrics "
@@ -37,7 +37,7 @@ def register(subparsers) -> None:
     add_engine_option(parser, many=True,
                       help="engines (default: every available engine, default preset)")
     parser.add_argument("--scenes", nargs="+", default=None, metavar="SCENE",
-                        help=f"only these cases (default: every scene tagged {STIFF_TAG!r})")
+                        help=f"only these cases (default: every scene tagged {STIFF!r})")
     add_runner_options(parser, timeout=300.0)
     parser.set_defaults(handler=run_stability)
 

@@ -73,13 +73,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from clearbench.adapters.energy_guard import ENERGY_EXPECTATIONS
 from clearbench.adapters.trajectory import RunStatus, Trajectory
 from clearbench.harness.measure import geometry_check
 from clearbench.harness.measure import series as metrics
-from clearbench.harness.measure.expectation_figures import ExpectationResult, evaluate
-from clearbench.harness.measure.verdicts import ANALYTIC_ERROR, analytic_error, judgement
+from clearbench.harness.measure.expectation_figures import evaluate, evaluate_implied
+from clearbench.harness.measure.verdicts import analytic_error, has_analytic_error, judgement
 from clearbench.scenarios.bodies import Motion
+from clearbench.scenarios.expectation_kinds import body_stays, energy_may_not_grow
 from clearbench.scenarios.scales import contact_feature_sizes, scene_size
 from clearbench.scenarios.scene import Scene
 
@@ -101,8 +101,6 @@ JOINT_BREAK_FRACTION = 0.05
 #: Ideal-joint axes (revolute) or relative orientations (prismatic, fixed) farther apart than
 #: this [rad] (5.7 degrees) mean the joint came apart.
 JOINT_BREAK_ANGLE = 0.1
-#: Expectation kinds whose body must not move.
-STICK_KINDS = frozenset({"incline_stick", "sticks"})
 
 
 @dataclass(frozen=True)
@@ -119,7 +117,7 @@ class Measurement:
 
 def has_analytic_reference(scene: Scene) -> bool:
     """True when an expectation of the scene has an analytic solution to measure error by."""
-    return any(e.kind in ANALYTIC_ERROR for e in scene.expectations)
+    return any(has_analytic_error(e.kind) for e in scene.expectations)
 
 
 def first_non_finite(trajectory: Trajectory) -> str | None:
@@ -141,14 +139,15 @@ def first_non_finite(trajectory: Trajectory) -> str | None:
 
 def _expectation_results(scene: Scene, trajectory: Trajectory, out: _Collector):
     """Every expectation's figures (also flattened into ``NAME.FIGURE`` figures), pass/fail,
-    criterion and detail (:mod:`.verdicts`), the implied energy balance check
-    (:func:`_energy_balance_result`), and the analytic error with its source."""
+    criterion and detail (:mod:`.verdicts`), the implied checks that apply
+    (:func:`~.expectation_figures.evaluate_implied`), and the analytic error with its
+    source."""
     expectations = {e.name: e for e in scene.expectations}
     results = []
     errors = []
     evaluated = evaluate(scene, trajectory)
-    implied = _energy_balance_result(scene, out)
-    for result in evaluated + ([implied] if implied is not None else []):
+    implied = evaluate_implied(scene, trajectory, out.figures)
+    for result in evaluated + implied:
         figures = {k: float(v) for k, v in result.figures.items()}
         expectation = expectations.get(result.name)
         verdict = judgement(scene, result.kind, expectation.body if expectation else None,
@@ -166,25 +165,6 @@ def _expectation_results(scene: Scene, trajectory: Trajectory, out: _Collector):
         return results, math.nan, ""
     value, name = max(errors)
     return results, value, f"analytic ({name})"
-
-
-#: Name of the implied expectation every run gets where the scene's energy balance is
-#: computed and the scene lists no energy expectation of its own.
-ENERGY_BALANCE = "energy_balance"
-
-
-def _energy_balance_result(scene: Scene, out: _Collector) -> ExpectationResult | None:
-    """The energy check every run gets when the energy balance is computed (no driver, point
-    force, moment or law load: ``energy_growth`` was measured) and the scene lists no energy
-    expectation: restitution e <= 1, friction and dampers only take energy, so a growth
-    beyond :data:`~.verdicts.ENERGY_GROWTH_ALLOWANCE` of the energy scale is wrong physics,
-    whatever the scene asks."""
-    growth = out.figures.get("energy_growth")
-    if growth is None or any(e.kind in ENERGY_EXPECTATIONS for e in scene.expectations):
-        return None
-    return ExpectationResult(ENERGY_BALANCE, ENERGY_BALANCE,
-                             {"energy_growth_relative": growth}, "energy_growth_relative",
-                             "implied: the scene's energy balance is computed")
 
 
 class _Collector:
@@ -267,8 +247,8 @@ def measure(scene: Scene, trajectory: Trajectory, reference: Trajectory | None =
     if math.isfinite(error):
         out.put("error", error)
     verdict = RunStatus.DIVERGED if reasons else RunStatus.OK
-    return Measurement(out.figures, tuple(results), verdict, "; ".join(reasons) or unseen,
-                       source, "; ".join(out.errors))
+    return Measurement(out.figures, tuple(results), verdict,
+                       _broken(trajectory, reasons) or unseen, source, "; ".join(out.errors))
 
 
 def _geometry(scene, trajectory, out: _Collector) -> str:
@@ -290,6 +270,15 @@ def _geometry(scene, trajectory, out: _Collector) -> str:
     return result.message(scene.units.length, scene.units.time)
 
 
+def _broken(trajectory: Trajectory, reasons: list[str]) -> str:
+    """The verdict's reason: what the engine said and what the harness found, when the engine
+    called a run ok that the harness judges broken (empty when it judges it sound)."""
+    if not reasons:
+        return ""
+    return (f"engine status {trajectory.status.value}, harness: diverged "
+            f"({'; '.join(reasons)})")
+
+
 def _drift(scene, trajectory, out: _Collector, reasons: list[str]) -> None:
     out.put("quaternion_norm_error_max", np.max(metrics.quaternion_norm_error(trajectory)))
     contacts = scene.expanded.contacts
@@ -303,8 +292,10 @@ def _drift(scene, trajectory, out: _Collector, reasons: list[str]) -> None:
         out.put("penetration_relative", np.max(relative))
         worst = int(np.argmax(relative))
         if relative[worst] > 1.0:
+            k = int(np.argmax(depth[:, worst] > feature[worst]))
             reasons.append(f"penetration {np.max(depth[:, worst]):.3g} in {contacts[worst].name}"
-                           f" exceeds its smallest feature {feature[worst]:.3g} (tunnelled)")
+                           f" exceeds its smallest feature {feature[worst]:.3g} (tunnelled, "
+                           f"from t = {trajectory.times[k]:.4g})")
         else:
             swept = metrics.swept_penetration(scene, trajectory)
             out.put("penetration_swept_max", np.max(swept))
@@ -322,8 +313,10 @@ def _drift(scene, trajectory, out: _Collector, reasons: list[str]) -> None:
         out.put("clearance_excess_relative", np.max(relative))
         worst = int(np.argmax(relative))
         if relative[worst] > BORE_ESCAPE_FACTOR:
-            reasons.append(f"journal of {motion.names[worst]} left its bore (excess "
-                           f"{relative[worst]:.3g} radial clearances)")
+            k = int(np.argmax(motion.excess[:, worst] > BORE_ESCAPE_FACTOR * radial[worst]))
+            reasons.append(f"journal of {motion.names[worst]} left its bore at t = "
+                           f"{trajectory.times[k]:.4g} (excess {relative[worst]:.3g} radial "
+                           "clearances)")
     if scene.joints:
         violation = metrics.joint_violation(scene, trajectory)
         out.put("joint_distance_max", np.max(violation.distance))
@@ -361,7 +354,7 @@ def _drivers(scene, trajectory, out: _Collector, reasons: list[str]) -> None:
 def _stiction(scene, trajectory, out: _Collector) -> None:
     worst = None
     for expectation in scene.expectations:
-        if expectation.kind not in STICK_KINDS:
+        if not body_stays(expectation.kind):
             continue
         start = float(expectation.parameters.get("start_time", 0.0))
         end = expectation.parameters.get("end_time")
@@ -387,7 +380,7 @@ def _energy(scene, trajectory, out: _Collector, reasons: list[str]) -> None:
     out.put("energy_growth", growth)
     free_rise, free_scale = metrics.energy_growth_contact_free(scene, trajectory, energy)
     out.put("energy_growth_contact_free", free_rise / free_scale)
-    must_not_grow = any(e.kind in ENERGY_EXPECTATIONS for e in scene.expectations)
+    must_not_grow = any(energy_may_not_grow(e.kind) for e in scene.expectations)
     if must_not_grow and growth > ENERGY_GROWTH_LIMIT:
         reasons.append(f"energy grew by {100 * growth:.3g} % of its scale {rise_scale:.3g} "
                        "(energy that may not grow)")

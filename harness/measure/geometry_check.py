@@ -177,8 +177,8 @@ def check(scene, trajectory, kernel_penetration: np.ndarray | None = None,
     first[::stride] = True
     first[-1:] = True
     # And each pair's deepest state by the kernel's figure, so that the two maxima compare.
-    deepest = np.argmax(kernel, axis=0) if count else np.zeros(0, dtype=int)
-    first[deepest, np.arange(pairs)] = True
+    if count:
+        first[np.argmax(kernel, axis=0), np.arange(pairs)] = True
     round_off = ROUND_OFF_FRACTION * scene_size(scene)
     reading = run_penetration(scene, trajectory, first)
     result = _result(scene, trajectory, kernel, reading, round_off, stride)

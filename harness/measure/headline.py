@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 
-from clearbench.harness.measure.figures import STICK_KINDS
+from clearbench.scenarios.expectation_kinds import body_stays, energy_may_not_grow
 from clearbench.scenarios.scene import Scene
 
 #: Metric name -> (short label, unit kind: "length", "relative", "rate", "angle", "count").
@@ -28,7 +28,7 @@ METRIC_LABELS: dict[str, tuple[str, str]] = {
 def scene_metric_names(scene: Scene) -> list[str]:
     """The metrics that matter for ``scene``, most telling first."""
     names = ["error"]
-    if any(e.kind in STICK_KINDS for e in scene.expectations):
+    if any(body_stays(e.kind) for e in scene.expectations):
         names += ["stiction_displacement", "stiction_creep_rate"]
     if scene.clearance_joints:
         names.append("clearance_excess_max")
@@ -36,7 +36,7 @@ def scene_metric_names(scene: Scene) -> list[str]:
         names += ["penetration_max", "instrument_penetration_max"]
     if scene.joints:
         names += ["joint_distance_max", "joint_angle_max"]
-    if any(e.kind in ("energy_conserved", "energy_non_increasing") for e in scene.expectations):
+    if any(energy_may_not_grow(e.kind) for e in scene.expectations):
         names += ["energy_growth", "energy_drift"]
     names.append("quaternion_norm_error_max")
     return list(dict.fromkeys(names))

@@ -522,3 +522,22 @@ def energy_growth_contact_free(scene: Scene, trajectory: Trajectory,
     if np.count_nonzero(free) >= 2:
         values = values.at(free)
     return _largest_rise(values), energy_scale(scene, values)
+
+
+def energy_loss(scene: Scene, trajectory: Trajectory,
+                values: Energy | None = None) -> tuple[float, float]:
+    """Largest fall of the total energy below its initial value [M L^2/T^2], and the energy
+    scale (:func:`energy_scale`). Judged on the samples where every contact is open when
+    there are at least two (the mechanical energy is then exact, with no estimate of the
+    energy stored in a compliant contact: measured, MuJoCo's elastic bouncing ball reads a
+    1.7 % fall mid-contact with the estimate and 0.04 % at its end), else on every sample
+    with the contact energy (a row of balls resting on a floor never opens every contact)."""
+    values = values if values is not None else energy(scene, trajectory)
+    total = values.total
+    free = contact_free(scene, trajectory)
+    if np.count_nonzero(free) >= 2:
+        mechanical = Energy(values.kinetic, values.gravity, values.springs).total
+        fall = float(total[0] - np.min(mechanical[free]))
+    else:
+        fall = float(total[0] - np.min(total))
+    return max(fall, 0.0), energy_scale(scene, values)

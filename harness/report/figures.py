@@ -19,8 +19,8 @@ import numpy as np
 
 from clearbench.adapters.trajectory import Trajectory
 from clearbench.harness.measure import series as metrics
-from clearbench.harness.measure.figures import STICK_KINDS
 from clearbench.harness.report.engine_style import engine_style
+from clearbench.scenarios.expectation_kinds import body_stays
 from clearbench.scenarios.scene import Scene
 
 LOG = logging.getLogger(__name__)
@@ -146,7 +146,7 @@ def time_series(scene: Scene, trajectory: Trajectory) -> dict[str, np.ndarray]:
         series[f"ideal-joint gap [{length}]"] = np.max(
             metrics.joint_violation(scene, trajectory).distance, axis=1)
     for expectation in scene.expectations:
-        if expectation.kind in STICK_KINDS:
+        if body_stays(expectation.kind):
             series[f"slip of {expectation.body} [{length}]"] = metrics.displacement(
                 scene, trajectory, expectation.body)
             break

@@ -44,6 +44,7 @@ from clearbench.harness.studies.campaign.report import render_markdown as campai
 from clearbench.harness.studies.campaign.report import section_html as campaign_section_html
 from clearbench.harness.studies.sweep import work_precision_points
 from clearbench.scenarios.scene import Scene
+from clearbench.scenarios.tags import STIFF
 
 LOG = logging.getLogger(__name__)
 
@@ -114,7 +115,7 @@ def collect(store: ResultsStore, figures: bool = True,
         if figures:
             _figures(store, section, colours)
         sections.append(section)
-    sections.sort(key=lambda s: (s.scene is not None and "stiff" in s.scene.tags, s.name))
+    sections.sort(key=lambda s: (s.scene is not None and STIFF in s.scene.tags, s.name))
     return ReportData(frame, sections, sorted(frame["label"].unique()) if len(frame) else [],
                       approximations, str(store.directory),
                       datetime.now(UTC).isoformat(timespec="seconds"),
@@ -271,7 +272,7 @@ def _verdict_legend_html() -> str:
 
 def _overview_html(data: ReportData, stiff: bool) -> str:
     sections = [s for s in data.sections
-                if (s.scene is not None and "stiff" in s.scene.tags) == stiff]
+                if (s.scene is not None and STIFF in s.scene.tags) == stiff]
     if not sections:
         return ""
     head = "".join(f"<th>{_esc(label)}</th>" for label in data.engines)
@@ -488,7 +489,7 @@ def render_markdown(data: ReportData, figure_files: dict, c60_figure_files: dict
              "Full report with figures: `report.html`.", ""]
     for stiff in (False, True):
         sections = [s for s in data.sections
-                    if (s.scene is not None and "stiff" in s.scene.tags) == stiff]
+                    if (s.scene is not None and STIFF in s.scene.tags) == stiff]
         if not sections:
             continue
         lines += [f"## {'Stiff and extreme suite' if stiff else 'Overview'}", "",

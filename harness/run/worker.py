@@ -108,8 +108,8 @@ def run_phase(request: dict):
         ran["engine_status"], ran["engine_message"] = status.value, message
         if status is RunStatus.OK:
             bad = first_non_finite(trajectory)
-            if bad is not None:
-                status, message = RunStatus.DIVERGED, bad
+            if bad is not None:  # the engine said ok: the verdict says both
+                status, message = RunStatus.DIVERGED, f"engine status ok, harness: diverged ({bad})"
                 trajectory.status, trajectory.message = status, message
         ran.update(status=status.value, message=message,
                    build_seconds=float(trajectory.build_seconds),

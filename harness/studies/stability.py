@@ -12,8 +12,7 @@ from clearbench.harness.measure.headline import scene_metric_names
 from clearbench.harness.run.engine_choice import EngineChoice, resolve_engine
 from clearbench.harness.run.spec import DEFAULT_TIMEOUT, RunSpec, make_run_spec
 from clearbench.scenarios.library import get_entry, scene_names
-
-STIFF_TAG = "stiff"
+from clearbench.scenarios.tags import STIFF
 
 
 def available_engines(extra_modules=None) -> list[EngineChoice]:
@@ -24,7 +23,7 @@ def available_engines(extra_modules=None) -> list[EngineChoice]:
 def plan_stability(engines: Sequence[EngineChoice], scenes: Sequence[str] | None = None,
                    timeout: float = DEFAULT_TIMEOUT, campaign: str = "stability") -> list[RunSpec]:
     """One run per stiff case and engine, at the case's own (hard) time step."""
-    names = list(scenes) if scenes else scene_names(STIFF_TAG)
+    names = list(scenes) if scenes else scene_names(STIFF)
     return [make_run_spec(name, engine.label, engine_choice=engine, timeout=timeout,
                           campaign=campaign) for name in names for engine in engines]
 

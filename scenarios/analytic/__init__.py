@@ -8,13 +8,21 @@ One import point for the closed-form solutions; each family lives in its own mod
   sliding to rolling;
 * :mod:`.analytic_rigid` -- pendulum on a revolute joint (Jacobi elliptic functions),
   torque-free rigid body (Euler's equations, Dzhanibekov flip), rigid-body energy;
-* :mod:`.analytic_linkages` -- slider–crank at constant crank speed.
+* :mod:`.analytic_linkages` -- slider–crank at constant crank speed;
+* :mod:`.edges` -- a hoop sliding without friction off a plate's sharp edge (pivot about the
+  edge, leave angle, free flight).
 
 All functions are pure and unit-agnostic (any consistent unit system; angles in radians), and
 vectorised over time: a time argument of any shape gives results of that shape (with a
 trailing axis of 3 for vectors). Misuse raises ValueError naming the argument.
 """
 
+from clearbench.scenarios.analytic.edges import (
+    HoopOverEdge,
+    hoop_over_edge_leave_angle,
+    hoop_over_edge_path,
+    hoop_over_edge_pivot_time,
+)
 from clearbench.scenarios.analytic.friction import (
     SOLID_SPHERE_INERTIA_RATIO,
     incline_block_acceleration,
@@ -74,11 +82,15 @@ from clearbench.scenarios.analytic.rigid import (
 
 __all__ = [
     "SOLID_SPHERE_INERTIA_RATIO",
+    "HoopOverEdge",
     "PolhodeAxis",
     "RigidBodyEnergy",
     "SliderCrankMotion",
     "TorqueFreePolhode",
     "bouncing_ball_apex_heights",
+    "hoop_over_edge_leave_angle",
+    "hoop_over_edge_path",
+    "hoop_over_edge_pivot_time",
     "bouncing_ball_apex_times",
     "bouncing_ball_height",
     "bouncing_ball_impact_speed",

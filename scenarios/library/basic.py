@@ -17,6 +17,7 @@ from clearbench.scenarios.outputs import PointPosition
 from clearbench.scenarios.registry import register
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.shapes import Box, Plane, Sphere
+from clearbench.scenarios.tags import ANALYTIC, SMOKE
 
 GRAVITY = 9.81  # m/s^2
 
@@ -31,39 +32,40 @@ def _tilt_about_y(angle: float) -> tuple:
     return (math.cos(0.5 * angle), 0.0, math.sin(0.5 * angle), 0.0)
 
 
+def bouncing_ball(restitution: float, drop_height: float = 1.0, radius: float = 0.1,
+                  mass: float = 1.0) -> Scene:
+    """Ball dropped from rest, its lowest point ``drop_height`` [m] above the plane."""
+    v0 = math.sqrt(2.0 * GRAVITY * drop_height)
+    rest = (v0 / GRAVITY) * (1.0 + restitution) / (1.0 - restitution)
+    return Scene(
+        description=f"Ball dropped from {drop_height} m onto a plane, Newton restitution "
+        f"{restitution}, no friction; apex heights e^(2k) h0, at rest after {rest:.3f} s.",
+        horizon=round(rest + 0.5, 3),
+        time_step=1e-3,
+        bodies=(
+            ground(),
+            Body("ball", mass=mass, inertia=solid_sphere(mass, radius),
+                 position=(0.0, 0.0, drop_height + radius),
+                 shapes=(Sphere("sphere", radius=radius),)),
+        ),
+        contacts=(ContactPair("ball_floor", body_a="ground", shape_a="floor",
+                              body_b="ball", shape_b="sphere", restitution=restitution),),
+        expectations=(
+            Expectation("apex_heights", kind="bounce_apex", body="ball", parameters={
+                "drop_height": drop_height, "restitution": restitution, "gravity": GRAVITY}),
+            Expectation("no_penetration", kind="no_penetration"),
+            Expectation("energy", kind="energy_non_increasing"),
+        ),
+    )
+
+
 for _e in (0.0, 0.5, 0.9):
-    @register(f"bouncing-ball-e{_e:g}", tags=("smoke", "analytic", "impact"),
-              summary=f"ball dropped 1 m on a plane, restitution {_e:g}", restitution=_e)
-    def bouncing_ball(restitution: float, drop_height: float = 1.0, radius: float = 0.1,
-                      mass: float = 1.0) -> Scene:
-        """Ball dropped from rest, its lowest point ``drop_height`` [m] above the plane."""
-        v0 = math.sqrt(2.0 * GRAVITY * drop_height)
-        rest = (v0 / GRAVITY) * (1.0 + restitution) / (1.0 - restitution)
-        return Scene(
-            name=f"bouncing-ball-e{restitution:g}",
-            description=f"Ball dropped from {drop_height} m onto a plane, Newton restitution "
-            f"{restitution}, no friction; apex heights e^(2k) h0, at rest after {rest:.3f} s.",
-            horizon=round(rest + 0.5, 3),
-            time_step=1e-3,
-            bodies=(
-                ground(),
-                Body("ball", mass=mass, inertia=solid_sphere(mass, radius),
-                     position=(0.0, 0.0, drop_height + radius),
-                     shapes=(Sphere("sphere", radius=radius),)),
-            ),
-            contacts=(ContactPair("ball_floor", body_a="ground", shape_a="floor",
-                                  body_b="ball", shape_b="sphere", restitution=restitution),),
-            expectations=(
-                Expectation("apex_heights", kind="bounce_apex", body="ball", parameters={
-                    "drop_height": drop_height, "restitution": restitution, "gravity": GRAVITY}),
-                Expectation("no_penetration", kind="no_penetration"),
-                Expectation("energy", kind="energy_non_increasing"),
-            ),
-            tags=("smoke", "analytic", "impact"),
-        )
+    register(f"bouncing-ball-e{_e:g}", tags=(SMOKE, ANALYTIC, "impact"),
+             summary=f"ball dropped 1 m on a plane, restitution {_e:g}",
+             restitution=_e)(bouncing_ball)
 
 
-def _box_on_incline(name: str, angle: float, friction: float, summary: str) -> Scene:
+def _box_on_incline(angle: float, friction: float, summary: str) -> Scene:
     half = (0.1, 0.1, 0.05)
     mass = 1.0
     tilt = _tilt_about_y(angle)
@@ -79,7 +81,6 @@ def _box_on_incline(name: str, angle: float, friction: float, summary: str) -> S
                     parameters={"angle": angle, "friction": friction, "gravity": GRAVITY})
     )
     return Scene(
-        name=name,
         description=summary,
         horizon=1.0,
         time_step=1e-3,
@@ -92,38 +93,36 @@ def _box_on_incline(name: str, angle: float, friction: float, summary: str) -> S
                               shape_b="box", friction=friction),),
         expectations=(expectation, Expectation("no_penetration", kind="no_penetration"),
                       Expectation("energy", kind="energy_non_increasing")),
-        tags=("smoke", "analytic", "friction") if sticks else ("analytic", "friction"),
     )
 
 
-@register("incline-stick", tags=("smoke", "analytic", "friction"),
+@register("incline-stick", tags=(SMOKE, ANALYTIC, "friction"),
           summary="box on a 10 degree incline, mu 0.3: must not move")
 def incline_stick(angle_degrees: float = 10.0, friction: float = 0.3) -> Scene:
     return _box_on_incline(
-        "incline-stick", math.radians(angle_degrees), friction,
+        math.radians(angle_degrees), friction,
         f"Box released on a {angle_degrees} degree incline with mu {friction} "
         "(tan(angle) < mu): exact stick, it must not move.",
     )
 
 
-@register("incline-slide", tags=("analytic", "friction"),
+@register("incline-slide", tags=(ANALYTIC, "friction"),
           summary="box on a 30 degree incline, mu 0.3: slides at g(sin - mu cos)")
 def incline_slide(angle_degrees: float = 30.0, friction: float = 0.3) -> Scene:
     return _box_on_incline(
-        "incline-slide", math.radians(angle_degrees), friction,
+        math.radians(angle_degrees), friction,
         f"Box released on a {angle_degrees} degree incline with mu {friction} "
         "(tan(angle) > mu): slides with acceleration g (sin - mu cos).",
     )
 
 
-@register("sliding-box", tags=("smoke", "analytic", "friction"),
+@register("sliding-box", tags=(SMOKE, ANALYTIC, "friction"),
           summary="box launched at 2 m/s on a plane, mu 0.3: stops at v0^2/(2 mu g)")
 def sliding_box(initial_speed: float = 2.0, friction: float = 0.3) -> Scene:
     half = (0.1, 0.1, 0.05)
     mass = 1.0
     stop = initial_speed / (friction * GRAVITY)
     return Scene(
-        name="sliding-box",
         description=f"Box launched at {initial_speed} m/s on a plane with mu {friction}: "
         f"stops after {stop:.4f} s at {initial_speed**2 / (2 * friction * GRAVITY):.4f} m.",
         horizon=round(stop + 0.3, 3),
@@ -141,18 +140,16 @@ def sliding_box(initial_speed: float = 2.0, friction: float = 0.3) -> Scene:
             Expectation("no_penetration", kind="no_penetration"),
             Expectation("energy", kind="energy_non_increasing"),
         ),
-        tags=("smoke", "analytic", "friction"),
     )
 
 
-@register("rolling-sphere", tags=("analytic", "friction"),
+@register("rolling-sphere", tags=(ANALYTIC, "friction"),
           summary="sphere launched sliding without spin: rolls from 2 v0/(7 mu g) at 5 v0/7")
 def rolling_sphere(initial_speed: float = 2.0, friction: float = 0.2,
                    radius: float = 0.1) -> Scene:
     mass = 1.0
     transition = 2.0 * initial_speed / (7.0 * friction * GRAVITY)
     return Scene(
-        name="rolling-sphere",
         description=f"Solid sphere launched at {initial_speed} m/s without spin, mu {friction}: "
         f"rolls without slip from {transition:.4f} s at {5 * initial_speed / 7:.4f} m/s.",
         horizon=round(transition + 0.3, 3),
@@ -172,11 +169,10 @@ def rolling_sphere(initial_speed: float = 2.0, friction: float = 0.2,
             Expectation("no_penetration", kind="no_penetration"),
             Expectation("energy", kind="energy_non_increasing"),
         ),
-        tags=("analytic", "friction"),
     )
 
 
-@register("rolling-incline", tags=("analytic", "friction"),
+@register("rolling-incline", tags=(ANALYTIC, "friction"),
           summary="sphere released on a 20 degree incline, mu 0.5: rolls at 5/7 g sin")
 def rolling_incline(angle_degrees: float = 20.0, friction: float = 0.5,
                     radius: float = 0.1) -> Scene:
@@ -190,7 +186,6 @@ def rolling_incline(angle_degrees: float = 20.0, friction: float = 0.5,
     probe_time = 0.5  # s
     travel = 0.5 * acceleration * probe_time**2
     return Scene(
-        name="rolling-incline",
         description=f"Solid sphere released at rest on a {angle_degrees} degree incline with "
         f"mu {friction} (tan(angle) <= 7/2 mu): rolls without slipping at "
         f"{acceleration:.4f} m/s^2.",
@@ -216,11 +211,10 @@ def rolling_incline(angle_degrees: float = 20.0, friction: float = 0.5,
             Expectation("no_penetration", kind="no_penetration"),
             Expectation("energy", kind="energy_non_increasing"),
         ),
-        tags=("analytic", "friction"),
     )
 
 
-@register("rocking-block", tags=("analytic", "impact", "friction"),
+@register("rocking-block", tags=(ANALYTIC, "impact", "friction"),
           summary="Housner rocking block: angular-velocity ratio 1 - 1.5 sin^2(alpha)")
 def rocking_block(half_width: float = 0.05, half_height: float = 0.25,
                   initial_tilt: float = 0.1, friction: float = 1.0) -> Scene:
@@ -238,7 +232,6 @@ def rocking_block(half_width: float = 0.05, half_height: float = 0.25,
     c, s = math.cos(tilt), math.sin(tilt)
     centre = (corner[0] + c * offset[0] + s * offset[2], 0.0, -s * offset[0] + c * offset[2])
     return Scene(
-        name="rocking-block",
         description=f"Block {2 * half_width} x {2 * half_height} m released tilted by "
         f"{initial_tilt} rad on its corner (mu {friction}, e = 0): Housner's rocking, "
         "angular-velocity ratio 1 - 1.5 sin^2(alpha) at each impact.",
@@ -257,7 +250,6 @@ def rocking_block(half_width: float = 0.05, half_height: float = 0.25,
             Expectation("no_penetration", kind="no_penetration"),
             Expectation("energy", kind="energy_non_increasing"),
         ),
-        tags=("analytic", "impact", "friction"),
     )
 
 
@@ -280,7 +272,6 @@ def box_grid(count: int = 26, friction: float = 0.5) -> Scene:
         contacts.append(ContactPair(f"{name}_floor", body_a="ground", shape_a="floor",
                                     body_b=name, shape_b="box", friction=friction))
     return Scene(
-        name="box-grid",
         description=f"{count} boxes dropped 1 mm onto a plane (mu {friction}); they settle with "
         f"{4 * count} active corner contacts.",
         horizon=0.2,
@@ -289,5 +280,4 @@ def box_grid(count: int = 26, friction: float = 0.5) -> Scene:
         contacts=tuple(contacts),
         expectations=(Expectation("no_penetration", kind="no_penetration"),
                       Expectation("energy", kind="energy_non_increasing")),
-        tags=("many_contacts", "friction"),
     )

@@ -30,38 +30,38 @@ from clearbench.scenarios.c60.variants import model_parameters
 from clearbench.scenarios.expectations import Expectation
 from clearbench.scenarios.registry import register
 from clearbench.scenarios.scene import Scene
+from clearbench.scenarios.tags import BENCH, C60
 
 #: Time after which the ON mechanism is settled (the source's settling moment on the bar ends at
 #: 1 ms; the joints have taken up their clearances by 2 ms) [ms].
 SETTLED_AFTER = 3.0
 
 
-@register("c60-on", tags=("c60",),
+@register("c60-on", tags=(C60,),
           summary="C-60 breaker in its ON pose: settles, stays latched; FC-1..FC-6")
 def c60_on(clearances: Mapping[str, float] | None = None, horizon: float = 7.0,
            time_step: float = 1e-3, variant: str = "source", **model) -> Scene:
     return c60_scene(
-        "c60-on", clearances=clearances, horizon=horizon, time_step=time_step,
+        clearances=clearances, horizon=horizon, time_step=time_step,
         parameters=model_parameters(variant, **model), plunger_speed=0.0,
-        expectations=(
-            Expectation("no_penetration", kind="no_penetration"),
+        expectations=(Expectation("no_penetration", kind="no_penetration"),) + ((
             Expectation("stays_latched", kind="sticks", body="hook",
-                        parameters={"start_time": min(SETTLED_AFTER, horizon),
-                                    "end_time": horizon}),
-        ),
+                        parameters={"start_time": SETTLED_AFTER, "end_time": horizon}),)
+            # A run that ends before the mechanism settles cannot judge the latch.
+            if horizon > SETTLED_AFTER else ()),
         description="Schneider Electric C-60 mechanism in its ON pose (mm, g, ms): the joints "
         "take up their clearances, the hook stays latched on the tripping bar and the moving "
         "contact rests on the fixed contact (FC-1).",
     )
 
 
-@register("c60-trip", tags=("c60",),
+@register("c60-trip", tags=(C60,),
           summary="C-60 magnetic trip: the plunger strikes the bar, the latch releases, C7 opens")
 def c60_trip(clearances: Mapping[str, float] | None = None, horizon: float = 20.0,
              time_step: float = 1e-3, plunger_speed: float = 0.2, plunger_start: float = 0.7,
              variant: str = "source", **model) -> Scene:
     return c60_scene(
-        "c60-trip", clearances=clearances, horizon=horizon, time_step=time_step,
+        clearances=clearances, horizon=horizon, time_step=time_step,
         parameters=model_parameters(variant, **model), plunger_speed=plunger_speed,
         plunger_start=plunger_start,
         description="Schneider Electric C-60 magnetic trip (the source's 20 ms run): the "
@@ -70,7 +70,7 @@ def c60_trip(clearances: Mapping[str, float] | None = None, horizon: float = 20.
     )
 
 
-@register("c60-contact-force-test", tags=("c60", "bench"),
+@register("c60-contact-force-test", tags=(C60, BENCH),
           summary="C-60 bench test: probe in place of the fixed contact, force vs displacement")
 def c60_contact_force_test(clearances: Mapping[str, float] | None = None,
                            probe_speed: float = 0.1, time_step: float = 1e-3,
@@ -81,7 +81,7 @@ def c60_contact_force_test(clearances: Mapping[str, float] | None = None,
         parameters=model_parameters(variant, **model))
 
 
-@register("c60-trip-force-test", tags=("c60", "bench"),
+@register("c60-trip-force-test", tags=(C60, BENCH),
           summary="C-60 bench test: probe pushes the tripping-bar pin until the latch releases")
 def c60_trip_force_test(clearances: Mapping[str, float] | None = None,
                         probe_speed: float = 0.02, time_step: float = 1e-3,

@@ -17,6 +17,7 @@ from clearbench.scenarios.outputs import BodyAngle, PointPosition
 from clearbench.scenarios.registry import register
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.shapes import Box, Plane
+from clearbench.scenarios.tags import ANALYTIC, SMOKE
 
 GRAVITY = 9.81  # m/s^2
 Y_AXIS = (0.0, 1.0, 0.0)
@@ -55,14 +56,13 @@ PENDULUM_OUTPUTS = (
 )
 
 
-@register("pendulum", tags=("smoke", "analytic", "joints"),
+@register("pendulum", tags=(SMOKE, ANALYTIC, "joints"),
           summary="pendulum on an ideal revolute joint: energy conserved, elliptic period")
 def pendulum(initial_angle: float = 1.0, length: float = 1.0, mass: float = 1.0,
              ) -> Scene:
     bob = _pendulum_bob(initial_angle, length, mass)
     pivot_inertia = pendulum_rod_inertia(mass, length)[0][0] + mass * length**2
     return Scene(
-        name="pendulum",
         description=f"Rod pendulum ({mass} kg, centre of mass {length} m below the pivot) on an "
         "ideal revolute joint, "
         f"released from rest at {initial_angle} rad: energy conserved, period from the "
@@ -79,11 +79,10 @@ def pendulum(initial_angle: float = 1.0, length: float = 1.0, mass: float = 1.0,
                 "gravity": GRAVITY, "initial_angle": initial_angle}),
             Expectation("energy", kind="energy_conserved"),
         ),
-        tags=("smoke", "analytic", "joints"),
     )
 
 
-@register("clearance-pendulum", tags=("smoke", "clearance", "friction"),
+@register("clearance-pendulum", tags=(SMOKE, "clearance", "friction"),
           summary="pendulum on a 3D revolute joint with radial and axial clearance")
 def clearance_pendulum(radial_clearance: float = 1e-4, axial_clearance: float = 1e-4,
                        initial_angle: float = 1.0, length: float = 1.0, mass: float = 1.0,
@@ -104,7 +103,6 @@ def clearance_pendulum(radial_clearance: float = 1e-4, axial_clearance: float = 
         restitution=restitution,
     )
     return Scene(
-        name="clearance-pendulum",
         description=f"The pendulum on a 3D revolute joint with radial clearance "
         f"{radial_clearance} m and axial clearance {axial_clearance} m (journal radius "
         f"{journal_radius} m, mu {friction}, e {restitution}).",
@@ -119,11 +117,10 @@ def clearance_pendulum(radial_clearance: float = 1e-4, axial_clearance: float = 
             Expectation("no_penetration", kind="no_penetration"),
             Expectation("energy", kind="energy_non_increasing"),
         ),
-        tags=("smoke", "clearance", "friction"),
     )
 
 
-@register("torque-free-flip", tags=("analytic", "gyroscopic"),
+@register("torque-free-flip", tags=(ANALYTIC, "gyroscopic"),
           summary="asymmetric body spun near its intermediate axis: flips, invariants conserved")
 def torque_free_flip(moments: tuple = (1.0, 2.0, 2.5), spin: float = 3.0,
                      perturbation: float = 0.01) -> Scene:
@@ -131,7 +128,6 @@ def torque_free_flip(moments: tuple = (1.0, 2.0, 2.5), spin: float = 3.0,
     its intermediate axis, perturbed by ``perturbation`` [rad/s] on the other two: the
     Dzhanibekov flip."""
     return Scene(
-        name="torque-free-flip",
         description=f"Torque-free body, principal moments {tuple(moments)} kg m^2, spun at "
         f"{spin} rad/s about the intermediate axis: energy and angular momentum conserved, "
         "periodic flips.",
@@ -142,7 +138,6 @@ def torque_free_flip(moments: tuple = (1.0, 2.0, 2.5), spin: float = 3.0,
                      angular_velocity=(perturbation, spin, perturbation)),),
         expectations=(Expectation("invariants", kind="torque_free", body="body"),
                       Expectation("energy", kind="energy_conserved")),
-        tags=("analytic", "gyroscopic"),
     )
 
 
@@ -159,7 +154,7 @@ def _planar_link(name: str, mass: float, length: float, inertia_z: float, pivot:
                 angular_velocity=(0.0, 0.0, angular_velocity), motion=motion)
 
 
-@register("slider-crank", tags=("analytic", "joints", "closed_loop"),
+@register("slider-crank", tags=(ANALYTIC, "joints", "closed_loop"),
           summary="slider-crank with ideal joints, crank driven at constant speed")
 def slider_crank(crank_length: float = 0.1, rod_length: float = 0.3,
                  crank_speed: float = 10.0) -> Scene:
@@ -176,7 +171,6 @@ def slider_crank(crank_length: float = 0.1, rod_length: float = 0.3,
     slider = Body("slider", mass=0.3, inertia=diagonal(1e-4, 1e-4, 1e-4),
                   position=(l1 + l2, 0.0, 0.0))
     return Scene(
-        name="slider-crank",
         description=f"Slider-crank (crank {l1} m, rod {l2} m) with ideal joints, crank driven "
         f"at {w} rad/s: closed-form slider kinematics.",
         gravity=(0.0, 0.0, -GRAVITY),
@@ -196,7 +190,6 @@ def slider_crank(crank_length: float = 0.1, rod_length: float = 0.3,
                  BodyAngle("crank_angle", body="crank", axis=Z_AXIS)),
         expectations=(Expectation("kinematics", kind="slider_crank", body="slider", parameters={
             "crank_length": l1, "rod_length": l2, "crank_speed": w, "offset": 0.0}),),
-        tags=("analytic", "joints", "closed_loop"),
     )
 
 
@@ -233,7 +226,6 @@ def flores_slider_crank(clearance: float = 0.001, friction: float = 0.01,
     ))
     contact = dict(friction=friction, restitution=restitution)
     return Scene(
-        name="flores-slider-crank",
         description=f"Slider-crank with a translational clearance of {clearance} m (Flores, "
         f"Leine, Glocker 2010): e_N {restitution}, mu {friction}, omega1 = 150 rad/s.",
         gravity=(0.0, -GRAVITY, 0.0),
@@ -257,5 +249,4 @@ def flores_slider_crank(clearance: float = 0.001, friction: float = 0.01,
                  BodyAngle("crank_angle", body="crank", axis=Z_AXIS)),
         expectations=(Expectation("no_penetration", kind="no_penetration"),
                       Expectation("energy", kind="energy_non_increasing")),
-        tags=("clearance", "impact", "friction"),
     )

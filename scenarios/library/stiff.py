@@ -19,34 +19,32 @@ from clearbench.scenarios.library.basic import GRAVITY, bouncing_ball, box_grid,
 from clearbench.scenarios.library.mechanisms import clearance_pendulum, slider_crank
 from clearbench.scenarios.loads import LinearSpringDamper
 from clearbench.scenarios.outputs import PointPosition
-from clearbench.scenarios.registry import SCENES, register
+from clearbench.scenarios.registry import register
 from clearbench.scenarios.scene import Scene
 from clearbench.scenarios.shapes import Box
+from clearbench.scenarios.tags import STIFF
 from clearbench.scenarios.units import UnitSystem
 
-STIFF_TAG = "stiff"
+
+def _described(scene: Scene, description: str, **changes) -> Scene:
+    """The scene with a new description (the registry gives it its name and tags)."""
+    return dataclasses.replace(scene, description=description, **changes)
 
 
-def _renamed(scene: Scene, name: str, description: str, **changes) -> Scene:
-    """The scene under a new name and description, with the tags it is registered with."""
-    tags = SCENES[name].tags
-    return dataclasses.replace(scene, name=name, description=description, tags=tags, **changes)
-
-
-@register("stiff-tight-clearance", tags=(STIFF_TAG, "clearance"),
+@register("stiff-tight-clearance", tags=(STIFF, "clearance"),
           summary="clearance pendulum with radial and axial clearance 1e-5 of the journal radius")
 def tight_clearance(relative_clearance: float = 1e-5) -> Scene:
     journal_radius = 0.01
     clearance = relative_clearance * journal_radius
     scene = clearance_pendulum(radial_clearance=clearance, axial_clearance=clearance,
                                journal_radius=journal_radius)
-    return _renamed(scene, "stiff-tight-clearance",
-                    f"The clearance pendulum with radial and axial clearance {clearance:g} m "
-                    f"({relative_clearance:g} of the journal radius): the journal must stay in "
-                    "its bore without chatter or drift.", horizon=1.0)
+    return _described(
+        scene, f"The clearance pendulum with radial and axial clearance {clearance:g} m "
+        f"({relative_clearance:g} of the journal radius): the journal must stay in "
+        "its bore without chatter or drift.", horizon=1.0)
 
 
-@register("stiff-mass-ratio", tags=(STIFF_TAG, "joints"),
+@register("stiff-mass-ratio", tags=(STIFF, "joints"),
           summary="slider-crank whose slider is 1e4 times heavier than its connecting rod")
 def mass_ratio(ratio: float = 1e4) -> Scene:
     scene = slider_crank()
@@ -57,12 +55,12 @@ def mass_ratio(ratio: float = 1e4) -> Scene:
         slider, mass=slider.mass * factor,
         inertia=tuple(tuple(factor * value for value in row) for row in slider.inertia))
     bodies = tuple(heavy if b.name == "slider" else b for b in scene.bodies)
-    return _renamed(scene, "stiff-mass-ratio",
-                    f"The driven slider-crank with a slider {ratio:g} times heavier than the "
-                    "rod across the wrist pin: the kinematics must still hold.", bodies=bodies)
+    return _described(
+        scene, f"The driven slider-crank with a slider {ratio:g} times heavier than the "
+        "rod across the wrist pin: the kinematics must still hold.", bodies=bodies)
 
 
-@register("stiff-spring", tags=(STIFF_TAG, "springs"),
+@register("stiff-spring", tags=(STIFF, "springs"),
           summary="ball on a linear spring with omega * dt = 10 at the comfortable step")
 def stiff_spring(omega_dt: float = 10.0, time_step: float = 1e-3,
                  initial_stretch: float = 1e-3) -> Scene:
@@ -76,7 +74,6 @@ def stiff_spring(omega_dt: float = 10.0, time_step: float = 1e-3,
     spring = LinearSpringDamper("spring", body_a="anchor", point_a=anchor, body_b="ball",
                                 stiffness=stiffness, rest_length=length - initial_stretch)
     return Scene(
-        name="stiff-spring",
         description=f"Ball ({ball.mass} kg) on an undamped spring of stiffness {stiffness:.3g} "
         f"N/m (omega dt = {omega_dt:g} at dt = {time_step:g} s), released stretched by "
         f"{initial_stretch} m: energy must not grow.",
@@ -86,29 +83,28 @@ def stiff_spring(omega_dt: float = 10.0, time_step: float = 1e-3,
         loads=(spring,),
         outputs=(PointPosition("height", body="ball", component="z"),),
         expectations=(Expectation("energy", kind="energy_non_increasing"),),
-        tags=(STIFF_TAG, "springs"),
     )
 
 
-@register("stiff-large-step-ball", tags=(STIFF_TAG, "impact"),
+@register("stiff-large-step-ball", tags=(STIFF, "impact"),
           summary="bouncing ball (e = 0.5) at a step 10 times the comfortable one")
 def large_step_ball(step_factor: float = 10.0) -> Scene:
     scene = bouncing_ball(restitution=0.5)
-    return _renamed(scene, "stiff-large-step-ball",
-                    f"{scene.description} Run at {step_factor:g} times the comfortable step.",
-                    time_step=scene.time_step * step_factor)
+    return _described(
+        scene, f"{scene.description} Run at {step_factor:g} times the comfortable step.",
+        time_step=scene.time_step * step_factor)
 
 
-@register("stiff-large-step-clearance", tags=(STIFF_TAG, "clearance"),
+@register("stiff-large-step-clearance", tags=(STIFF, "clearance"),
           summary="clearance pendulum at a step 10 times the comfortable one")
 def large_step_clearance(step_factor: float = 10.0) -> Scene:
     scene = clearance_pendulum()
-    return _renamed(scene, "stiff-large-step-clearance",
-                    f"{scene.description} Run at {step_factor:g} times the comfortable step.",
-                    time_step=scene.time_step * step_factor)
+    return _described(
+        scene, f"{scene.description} Run at {step_factor:g} times the comfortable step.",
+        time_step=scene.time_step * step_factor)
 
 
-@register("stiff-tunnelling", tags=(STIFF_TAG, "impact"),
+@register("stiff-tunnelling", tags=(STIFF, "impact"),
           summary="5 mm ball at 50 m/s onto a 2 mm plate: 50 mm per step, it must not tunnel")
 def tunnelling(speed: float = 50.0, radius: float = 0.005,
                plate_half_thickness: float = 0.001) -> Scene:
@@ -127,7 +123,6 @@ def tunnelling(speed: float = 50.0, radius: float = 0.005,
     horizon = 0.2
     arrival = 0.05 / speed
     return Scene(
-        name="stiff-tunnelling",
         description=f"A {2000 * radius:g} mm ball at {speed} m/s onto a "
         f"{2000 * plate_half_thickness:g} mm plate (e = 0): {1000 * speed * scene.time_step:g} "
         "mm per step at the "
@@ -144,18 +139,17 @@ def tunnelling(speed: float = 50.0, radius: float = 0.005,
             Expectation("no_penetration", kind="no_penetration"),
             Expectation("energy", kind="energy_non_increasing"),
         ),
-        tags=(STIFF_TAG, "impact"),
     )
 
 
-@register("stiff-high-friction", tags=(STIFF_TAG, "friction"),
+@register("stiff-high-friction", tags=(STIFF, "friction"),
           summary="box on a 60 degree incline with mu = 2: must not move")
 def high_friction(friction: float = 2.0, angle_degrees: float = 60.0) -> Scene:
     scene = incline_stick(angle_degrees=angle_degrees, friction=friction)
-    return _renamed(scene, "stiff-high-friction", scene.description)
+    return scene
 
 
-@register("stiff-elastic", tags=(STIFF_TAG, "impact"),
+@register("stiff-elastic", tags=(STIFF, "impact"),
           summary="ball bouncing with e = 1: energy must not grow, apex must not change")
 def elastic(drop_height: float = 1.0) -> Scene:
     scene = bouncing_ball(restitution=0.9, drop_height=drop_height)
@@ -167,20 +161,20 @@ def elastic(drop_height: float = 1.0) -> Scene:
         Expectation("energy", kind="energy_non_increasing"),
     )
     period = 2.0 * math.sqrt(2.0 * drop_height / GRAVITY)
-    return _renamed(scene, "stiff-elastic",
-                    f"Ball dropped from {drop_height} m with Newton restitution 1: every apex "
-                    "at the drop height, energy must not grow.", contacts=contacts,
-                    expectations=expectations, horizon=round(3.4 * period, 3))
+    return _described(
+        scene, f"Ball dropped from {drop_height} m with Newton restitution 1: every apex "
+        "at the drop height, energy must not grow.", contacts=contacts,
+        expectations=expectations, horizon=round(3.4 * period, 3))
 
 
-@register("stiff-many-contacts", tags=(STIFF_TAG, "many_contacts"),
+@register("stiff-many-contacts", tags=(STIFF, "many_contacts"),
           summary="36 boxes on a plane: 144 simultaneous corner contacts")
 def many_contacts(count: int = 36) -> Scene:
     scene = box_grid(count=count)
-    return _renamed(scene, "stiff-many-contacts", scene.description)
+    return scene
 
 
-@register("stiff-millimetre-parts", tags=(STIFF_TAG, "clearance"),
+@register("stiff-millimetre-parts", tags=(STIFF, "clearance"),
           summary="the clearance pendulum shrunk to a 1 cm, 1 g rod with micrometre clearances, "
           "in SI units")
 def millimetre_parts() -> Scene:
@@ -192,6 +186,6 @@ def millimetre_parts() -> Scene:
     small = dataclasses.replace(scene, units=UnitSystem("cm", "g", "s"),
                                 gravity=tuple(100.0 * g for g in scene.gravity))
     shrunk = small.rescaled(UnitSystem())
-    return _renamed(shrunk, "stiff-millimetre-parts",
-                    "The clearance pendulum shrunk to a 1 cm rod of 1 g, journal radius 0.1 mm "
-                    "and 1 um clearances, in SI units.", horizon=0.5, time_step=1e-4)
+    return _described(
+        shrunk, "The clearance pendulum shrunk to a 1 cm rod of 1 g, journal radius 0.1 mm "
+        "and 1 um clearances, in SI units.", horizon=0.5, time_step=1e-4)

@@ -40,17 +40,18 @@ from clearbench.harness.measure.instrument.placement import (
     relative_transforms,
     shape_placements,
 )
-from clearbench.harness.measure.instrument.search import minimise
+from clearbench.harness.measure.instrument.search import CELLS_PER_STATE, minimise
 from clearbench.harness.measure.instrument.solids import Solid
 from clearbench.harness.measure.instrument.surfaces import boundary_patches
 
 #: Default resolution of a reading, as a fraction of the pair's smallest length (radius, half
-#: length, half extent, depth or tube radius of either shape): 1e-5 resolves a C-60 arc's
-#: (r 0.5 mm) gaps to 5 nm, a thousandth of its 5 um clearances and far below the 19 um the
-#: old kernel missed. The search's cost hardly depends on it (its bounds are second order
-#: where the contact is smooth): on a 201-state MuJoCo c60-on, 1e-3, 1e-4 and 1e-5 took
-#: 1.31, 1.41 and 1.47 s.
-RESOLUTION_FRACTION = 1e-5
+#: length, half extent, depth or tube radius of either shape): 1e-6 resolves a C-60 arc's
+#: (r 0.5 mm) gaps to 0.5 nm, far below its 5 um clearances, the compliant engines'
+#: penetrations of 0.1-1 um and the 19 um the old kernel missed. The search's cost hardly
+#: depends on it (its bounds are second order where the contact is smooth): reading a
+#: 201-state MuJoCo c60-on took 1.31, 1.41 and 1.47 s at 1e-3, 1e-4 and 1e-5 (wall, in turn),
+#: and 0.87-0.92 s of CPU at 1e-6 against 0.82-0.93 s at 1e-5.
+RESOLUTION_FRACTION = 1e-6
 
 _FACE_KINDS = ("rectangle", "disc", "bore")
 
@@ -152,7 +153,8 @@ def _screen(sampled: Solid, rotation, translation, partner: Solid, states) -> np
 
 
 def pair_gaps(shape_a, poses_a, shape_b, poses_b, resolution: float | None = None,
-              floor=None, states=None, polish: bool = True) -> PairGaps:
+              floor=None, states=None, polish: bool = True,
+              cells_per_state: int = CELLS_PER_STATE) -> PairGaps:
     """The instrument's reading of a pair at T configurations of its two bodies.
 
     Parameters
@@ -171,6 +173,9 @@ def pair_gaps(shape_a, poses_a, shape_b, poses_b, resolution: float | None = Non
     polish : bool
         Refine each witness by a bounded local search (exact to round-off where the minimum
         is smooth); without it the gap is within ``resolution`` of the minimum all the same.
+    cells_per_state : int
+        The search's cap per configuration (:mod:`.search`); a reading stopped there has the
+        larger resolution it reached.
     """
     a, b = Solid(shape_a), Solid(shape_b)
     do_ab, do_ba = _terms(a, b)
@@ -207,7 +212,8 @@ def pair_gaps(shape_a, poses_a, shape_b, poses_b, resolution: float | None = Non
                          searched)
         patches = boundary_patches(solid, clip)
         m, d = relative_transforms(rotation, position, other_rotation, other_position)
-        result = minimise(patches, m, d, other, tolerance, floor, searched, polish)
+        result = minimise(patches, m, d, other, tolerance, floor, searched, polish,
+                          cells_per_state)
         lower[searched] = np.minimum(lower[searched], result.lower[searched])
         better = searched[result.best[searched] < gap[searched]]
         if not len(better):

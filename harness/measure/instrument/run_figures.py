@@ -12,9 +12,10 @@ A state read first meets a screen (one evaluation): the partner's
 exact signed distance at the centre of the bounded shape's bounding sphere, less its radius, is
 a lower bound of G (a signed distance is 1-Lipschitz); where that bound is above both 0 and the
 offset, the pair cannot penetrate at that state and its penetration is 0 exactly. Every other
-state is searched to the pair's resolution with the offset as floor (:func:`.search.minimise`):
-the witnessed penetration is a real point's, and the true one (as :mod:`.pair` defines it) is
-at most ``penetration + resolution``.
+state is searched to the pair's resolution with the offset as floor (:func:`.search.minimise`,
+at most :data:`RUN_CELLS_PER_STATE` cells per state): the witnessed penetration is a real
+point's, and the true one (as :mod:`.pair` defines it) is at most ``penetration +
+resolution``.
 
 A ring around a journal (a circle or arc against a cylinder whose axis crosses the ring's
 plane inside the ring in the scene's initial configuration: a bearing ring of a clearance
@@ -33,6 +34,12 @@ import numpy as np
 
 from clearbench.harness.measure.instrument.pair import pair_gaps, pair_resolution
 from clearbench.harness.measure.instrument.placement import shape_placements
+
+#: The search's budget of cells per state and pair when reading a run: a state where the
+#: deepest points fill a curve (a part sunk through half a thin one, in a diverged run) then
+#: reports the coarser resolution it reached instead of costing seconds; the C-60 demo runs'
+#: states stay below it (at most about 1,250 on average over a run's states and pairs).
+RUN_CELLS_PER_STATE = 5_000
 
 
 @dataclass(frozen=True)
@@ -148,7 +155,8 @@ def run_penetration(scene, trajectory, read=None) -> RunPenetration:
             continue
         reading = pair_gaps(shape_a, poses_a, shape_b, poses_b,
                             resolution=pair_resolution(shape_a, shape_b),
-                            floor=np.full(count, contact.offset), states=states, polish=False)
+                            floor=np.full(count, contact.offset), states=states, polish=False,
+                            cells_per_state=RUN_CELLS_PER_STATE)
         witnessed = np.maximum(0.0, contact.offset - reading.gap[states])
         bound = np.maximum(0.0, contact.offset - reading.lower[states])
         penetration[states, k] = witnessed

@@ -14,9 +14,13 @@ A cell whose lower bound is at least (best witness - tolerance), or at least the
 ``floor`` (the search only needs to know that f stays above it there), is dropped; the others
 are halved along their longer side. On exit every part of the surface is covered by a dropped
 cell, so the minimum lies in [lower, best] with lower = the smallest bound of a dropped cell
->= min(best - tolerance, floor). The cells are capped (:data:`MAX_CELLS` at a level,
-:data:`MAX_LEVELS` halvings); a search stopped there reports the bound it reached, never the
-tolerance it aimed at.
+>= min(best - tolerance, floor). The cells are capped (:data:`CELLS_PER_STATE` evaluated per
+configuration searched, :data:`MAX_CELLS` alive in all at a level, :data:`MAX_LEVELS`
+halvings);
+a search stopped there reports the bound it reached, never the tolerance it aimed at. That
+happens where a whole curve of the boundary is a minimum no bound can single out, the medial
+surface of a solid (a ball sunk more than half through a slab: every point of a circle on it
+is deepest).
 """
 
 from __future__ import annotations
@@ -27,7 +31,8 @@ import numpy as np
 
 from clearbench.harness.measure.instrument.solids import combine
 
-#: Most cells alive at one level of the search (all configurations together).
+#: Most cells evaluated per configuration searched, and alive at one level in all.
+CELLS_PER_STATE = 300_000
 MAX_CELLS = 2_000_000
 #: Most levels of halving.
 MAX_LEVELS = 120
@@ -66,7 +71,8 @@ def _initial_cells(patches, states: np.ndarray):
 
 
 def minimise(patches, rotation: np.ndarray, translation: np.ndarray, partner, tolerance,
-             floor=None, states=None, polish: bool = True) -> SearchResult:
+             floor=None, states=None, polish: bool = True,
+             cells_per_state: int = CELLS_PER_STATE) -> SearchResult:
     """Minimise the partner's signed distance over the patches at T configurations.
 
     Parameters
@@ -81,12 +87,15 @@ def minimise(patches, rotation: np.ndarray, translation: np.ndarray, partner, to
         Resolution aimed at [L] (> 0).
     floor : ndarray (T,), optional
         Values the caller needs resolved only below this [L]: a cell whose lower bound is above
-        it is dropped (default: -inf, resolve everything).
+        it is dropped (default: +inf, resolve everything).
     states : ndarray of int, optional
         Configurations to search (default all); the others keep best = lower = +inf.
     polish : bool
         Refine the witness by a bounded local search (:func:`_polish`); the certified bound
         does not depend on it.
+    cells_per_state : int
+        The budget of cells evaluated per configuration (the search stops there and reports
+        the bound it reached).
     """
     count = len(rotation)
     tolerance = np.broadcast_to(np.asarray(tolerance, dtype=np.float64), (count,))
@@ -100,6 +109,8 @@ def minimise(patches, rotation: np.ndarray, translation: np.ndarray, partner, to
     if not len(patches) or not len(states):
         return SearchResult(best, witness, lower)
     state, patch_index, u, v, hu, hv = _initial_cells(patches, states)
+    cap = min(MAX_CELLS, cells_per_state * len(states))
+    work = np.zeros(count, dtype=np.int64)
     rotation_t = np.swapaxes(rotation, 1, 2)
     for _level in range(MAX_LEVELS):
         values = np.empty(len(state))
@@ -131,10 +142,23 @@ def minimise(patches, rotation: np.ndarray, translation: np.ndarray, partner, to
             if factors:
                 model, loss_u, loss_v = _factor_bounds(factors, patch, rotation_t[s], uk, vk,
                                                        huk, hvk, su * huk, sv * hvk)
+                for normal, offset in partner.half_spaces():
+                    # The solid lies in {n . q <= c}: its signed distance is >= n . q - c.
+                    n_local = np.einsum("nij,j->ni", rotation_t[s], normal)
+                    part_u, part_v = patch.drop(n_local, uk, vk, huk, hvk)
+                    plane = mapped @ normal - offset - part_u - part_v
+                    wins = plane > model
+                    model = np.where(wins, plane, model)
+                    loss_u = np.where(wins, part_u, loss_u)
+                    loss_v = np.where(wins, part_v, loss_v)
                 better = model > bound
                 bound = np.where(better, model, bound)
-                # The metric decides where neither side loses anything.
-                by_loss = np.where(loss_u + loss_v > 0.0, loss_u >= loss_v, split_u)
+                # Halve the side that loses most where the losses make the bound's slack;
+                # where the model itself is loose (a superset far from the solid), the
+                # metric's longer side: smaller cells are what the Lipschitz bound needs.
+                losses = loss_u + loss_v
+                by_loss = np.where((losses > 0.0) & (2.0 * losses >= f - model),
+                                   loss_u >= loss_v, split_u)
                 split_u = np.where(better, by_loss, split_u)
             values[rows], bounds[rows], points[rows], radii[rows] = f, bound, local, radius
             wide_u[rows] = split_u
@@ -150,9 +174,17 @@ def minimise(patches, rotation: np.ndarray, translation: np.ndarray, partner, to
         dropped = bounds >= threshold
         np.minimum.at(lower, state[dropped], bounds[dropped])
         keep = ~dropped
+        # A configuration whose evaluated cells would pass its budget stops here with the
+        # bound it reached.
+        work += np.bincount(state, minlength=count)
+        alive = np.bincount(state[keep], minlength=count)
+        stopped = keep & (work[state] + 2 * alive[state] > cells_per_state)
+        if stopped.any():
+            np.minimum.at(lower, state[stopped], bounds[stopped])
+            keep &= ~stopped
         if not keep.any():
             break
-        if _level == MAX_LEVELS - 1 or 2 * np.count_nonzero(keep) > MAX_CELLS:
+        if _level == MAX_LEVELS - 1 or 2 * np.count_nonzero(keep) > cap:
             np.minimum.at(lower, state[keep], bounds[keep])
             break
         state, patch_index, u, v, hu, hv, wide = (state[keep], patch_index[keep], u[keep],

@@ -185,6 +185,27 @@ def _inside_cylinder(points: np.ndarray, outer: float, radius: np.ndarray):
     return value, radial, -1.0 / (rho + radius), across
 
 
+def _torus(points: np.ndarray, ring: float, tube: float, radius: np.ndarray):
+    """Lower model of the torus's signed distance g(rho, z) - tube, g = |(rho - ring, z)|:
+    g is convex in (rho, z), so g' >= g + a (rho' - rho) + b (z' - z) with (a, b) its unit
+    gradient; rho' - rho lies within rho^.D + |D_perp|^2 / (2 (rho +- |D_xy|)), a gain where
+    a > 0 (curvature -a / (rho + r)) and a loss where a < 0 (|a| / (rho - r), inf where the
+    ball of radius r reaches the axis)."""
+    value, radial = _round(points, 0.0)
+    rho = value
+    z = points[:, 2]
+    meridian = np.hypot(rho - ring, z)
+    safe = np.where(meridian > 0.0, meridian, 1.0)
+    a = np.where(meridian > 0.0, (rho - ring) / safe, 1.0)
+    b = np.where(meridian > 0.0, z / safe, 0.0)
+    normal = a[:, None] * radial + b[:, None] * np.array([0.0, 0.0, 1.0])
+    clearance = rho - radius
+    loss = np.where(clearance > 0.0, -a / np.maximum(clearance, 1e-300), np.inf)
+    curvature = np.where(a > 0.0, -a / (rho + radius), loss)
+    across = np.stack([-radial[:, 1], radial[:, 0], np.zeros(len(rho))], axis=1)
+    return meridian - tube, normal, curvature, across
+
+
 def _outside_cylinder(points: np.ndarray, inner: float, radius: np.ndarray):
     """Lower model of the signed distance of {rho >= inner} (value inner - rho) for the balls
     of ``radius`` (N,) around ``points``: in the xy-plane |c + D| <= |c| + c^.D + (w.D)^2 /
@@ -297,8 +318,10 @@ class Solid:
         never larger; an intersection's is at least each part's): a bore by (rho >= R and,
         with a depth, rho <= R + depth) x (|z| <= half_length), the first model concave
         across the radius (value R - rho, curvature 1 / (rho - r) along w = z x rho^ for a
-        ball of radius r off the axis); a ring's tube by (R - t <= rho <= R + t) x
-        (|z| <= t). A bare curve has none (the search falls back on the Lipschitz bound)."""
+        ball of radius r off the axis); a ring's tube by its whole torus (an arc's tube lies
+        in it), whose signed distance sqrt((rho - R)^2 + z^2) - t is convex in (rho, z):
+        its tangent there, with rho's own curvature across the radius. A bare curve has none
+        (the search falls back on the Lipschitz bound)."""
         p = np.asarray(points, dtype=np.float64)
         s = self.shape
         # Products of sets: one factor per set, each its own tangent (a kink of the product,
@@ -324,10 +347,20 @@ class Solid:
                 radial.append(_flat(_round(p, s.radius + s.depth)))
             return [radial, [_flat(_interval(p, 2, s.half_length))]]
         if self.tube > 0.0:
-            radial = [_flat(_round(p, s.radius + self.tube))]
-            if s.radius > self.tube:
-                radial.append(_outside_cylinder(p, s.radius - self.tube, radius))
-            return [radial, [_flat(_interval(p, 2, self.tube))]]
+            return [[_torus(p, s.radius, self.tube, radius)]]
+        return []
+
+    def half_spaces(self) -> list[tuple[np.ndarray, float]]:
+        """Half-spaces {n . p <= c} (unit n (3,), c [L]) that hold the whole solid, for the
+        search's extra lower bounds (the solid's signed distance is at least n . p - c): the
+        two sides of the wedge of angles of a bore or an arc's tube spanning at most pi (the
+        tube reaches its radius beyond them)."""
+        if self.kind == "bore" or (self.kind == "arc" and self.tube > 0.0):
+            start, end = self.shape.start_angle, self.shape.end_angle
+            if end - start <= math.pi:
+                reach = self.tube if self.kind == "arc" else 0.0
+                return [(np.array([math.sin(start), -math.cos(start), 0.0]), reach),
+                        (np.array([-math.sin(end), math.cos(end), 0.0]), reach)]
         return []
 
     def distance(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -236,11 +236,13 @@ class Patch:
             # p - p_c = (rho - rho_c) e(phi) + rho_c (e(phi) - e(phi_c)), e the radial unit.
             tangent = np.stack([-np.sin(v), np.cos(v), np.zeros(len(v))], axis=1)
             radial = np.stack([np.cos(v), np.sin(v), np.zeros(len(v))], axis=1)
-            n_radial = np.abs(np.sum(n * radial, axis=1))
+            n_radial = np.sum(n * radial, axis=1)
             n_tangent = np.abs(np.sum(n * tangent, axis=1))
             n_planar = np.hypot(n[:, 0], n[:, 1])
-            return (n_radial * hu + n_planar * hu * hv,
-                    u * (n_tangent * hv + n_radial * 0.5 * hv * hv))
+            # rho_c (e(phi) - e(phi_c)) = rho_c (sin t^ - (1 - cos) r^): a loss of the
+            # second term only where n.r^ > 0.
+            return (np.abs(n_radial) * hu + n_planar * hu * hv,
+                    u * (n_tangent * hv + np.maximum(n_radial, 0.0) * 0.5 * hv * hv))
         if self.kind in ("cylinder", "curve", "torus"):
             core = d["r"] if self.kind == "cylinder" else d["R"]
             tangent = np.stack([-np.sin(u), np.cos(u), np.zeros(len(u))], axis=1)

@@ -5,7 +5,8 @@ case).
 Every figure comes from :func:`clearbench.harness.measure.expectation_figures.evaluate`, the
 evaluator every engine is judged by, so the columns of every engine and of the reference solver
 are computed by the same code. This module only chooses which figures to show and in which
-display unit.
+display unit: the columns of each expectation kind (its ``table``,
+:class:`~clearbench.harness.measure.kinds.TableColumn`).
 """
 
 from __future__ import annotations
@@ -16,45 +17,9 @@ from dataclasses import dataclass
 from clearbench.adapters.base import Engine, RunSettings
 from clearbench.adapters.trajectory import RunStatus
 from clearbench.harness.measure.expectation_figures import evaluate
+from clearbench.harness.measure.kinds import measured_kind
 from clearbench.scenarios.library import get_scene, scene_names
 from clearbench.scenarios.scene import Scene
-
-
-@dataclass(frozen=True)
-class Figure:
-    """A figure of an expectation shown in the table: key in the evaluator's figures, label,
-    display factor and unit (factor applied to values in SI scene units)."""
-
-    key: str
-    label: str
-    factor: float = 1.0
-    unit: str = ""
-
-
-#: Figures shown per expectation kind (the evaluator computes more).
-TABLE_FIGURES: dict[str, tuple[Figure, ...]] = {
-    "bounce_apex": (Figure("apex_1_relative_error", "1st apex height, relative error", 100, "%"),
-                    Figure("apex_max_relative_error", "worst apex height, relative error",
-                           100, "%"),
-                    Figure("height_after_rest", "height after t_inf", 1e3, "mm")),
-    "incline_stick": (Figure("displacement", "creep below the friction angle", 1e6, "um"),),
-    "incline_slide": (Figure("acceleration_relative_error", "sliding acceleration, relative "
-                             "error", 100, "%"),),
-    "sliding_stop": (Figure("stop_distance_error", "stop distance error", 1e3, "mm"),),
-    "rolling_transition": (Figure("final_speed_relative_error", "rolling speed, relative error",
-                                  100, "%"),),
-    "rocking_ratio": (Figure("ratio_relative_error", "impact velocity ratio, relative error",
-                             100, "%"),),
-    "pendulum": (Figure("energy_drift", "energy drift / (m g d)", 100, "%"),
-                 Figure("period_relative_error", "period, relative error", 100, "%")),
-    "torque_free": (Figure("angular_momentum_drift", "angular momentum drift / L0", 100,
-                           "%"),),
-    "slider_crank": (Figure("slider_position_max_error", "slider position error", 1e6, "um"),),
-    "approaches_ideal": (Figure("clearance_excess", "clearance excess", 1e6, "um"),),
-    "no_penetration": (Figure("penetration_max", "penetration", 1e3, "mm"),),
-    "energy_non_increasing": (Figure("energy_growth_relative", "energy growth / energy scale",
-                                     100, "%"),),
-}
 
 #: Scenes of the tables: the analytic library plus the clearance pendulum.
 DEFAULT_SCENES = tuple(scene_names("analytic")) + ("clearance-pendulum",)
@@ -95,12 +60,8 @@ def table_rows(scene: Scene, cells: list[Cell]) -> list[tuple[str, list[str]]]:
     """(label, one formatted value per cell) for every shown figure of ``scene``."""
     rows = []
     for expectation in scene.expectations:
-        for figure in TABLE_FIGURES.get(expectation.kind, ()):
-            if figure.key == "height_after_rest" and \
-                    expectation.parameters.get("restitution", 0.0) > 0:
-                continue
-            if figure.key.startswith("apex_") and \
-                    expectation.parameters.get("restitution", 1.0) == 0:
+        for figure in measured_kind(expectation.kind).table:
+            if not figure.shown(expectation.parameters):
                 continue
             values = []
             for cell in cells:
