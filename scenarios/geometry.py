@@ -13,7 +13,8 @@ Conventions (kept exactly by every pair)
 - Where ``p_B`` is the closest point of B to a material point of A (or the reverse), the gap
   is a signed distance whose gradient with respect to a translation of B is ``n`` and with
   respect to a translation of A is ``-n``. This holds for every pair except box-box points
-  created by clipping (see below).
+  created by clipping, and a bare ring's deepest point inside a face's solid where two of its
+  faces are equally near (see below).
 - Swapping A and B gives the same gaps, swapped points and the opposite normals (exactly: the
   kernels run one canonical order and mirror it; same-kind pairs pick their order from the
   data, not from the argument order).
@@ -57,17 +58,32 @@ cylinder-plane     8   on each end rim: the lowest point and the points 90, 180,
                        cylinder; a standing cylinder gets 4 points on its bottom rim). The lowest
                        point of the solid is always one of indices 0, 1. Rim parallel to the
                        plane: the rim points start from the cylinder's own x axis.
-circle-plane       1   lowest point of the circle along -n (closed form). Circle parallel to the
-                       plane: the point at angle 0 (the circle's x axis).
-arc-plane          1   lowest point of the circle if its angle lies in the arc, else the lower arc
-                       end. Arc parallel to the plane: its middle point.
+circle-plane       8   a ring against a face's solid (below, with rectangle-X and disc-X).
+arc-plane          8
 circle-cylinder    1   bearing ring against a journal, or ring against a pin (below).
 arc-cylinder       1   the same, restricted to the arc's angles (else the better arc end).
-rectangle-X       0-8  X = sphere, cylinder, circle, arc: the plane pair, keeping only the
-disc-X                 candidates whose point on the face lies inside the face (|x| <= half_x,
-                       |y| <= half_y; or x^2 + y^2 <= r^2) and whose gap is not below -depth
-                       (behind the solid, not in it). A contact that slides off the face is
-                       lost (edges are not modelled). Gap and normal are the plane's.
+rectangle-X       1-8  X = sphere (1), cylinder (8), circle (8), arc (8). A face has a solid
+disc-X                 behind it: the slab |x| <= half_x, |y| <= half_y (or x^2 + y^2 <= r^2),
+                       -depth <= z <= 0 (no depth: unbounded below); a plane's is z <= 0. Every
+                       candidate's gap is its signed distance to that solid: over the face the
+                       plane's gap and normal, beyond the bound the distance to the face's edge
+                       (or corner) along the direction from it, behind a slab its back face; so
+                       gap and normal are continuous while a partner crosses the bound. A
+                       sphere: its centre's distance minus its radius. A cylinder: its 8 rim
+                       points of cylinder-plane (chosen with respect to the face's normal); its
+                       lateral surface across the face's edge is NOT a candidate. A ring or arc
+                       (kernels/gaps/ring_faces.py): slots 0-5 six support points (a circle's
+                       60 degrees apart from the face's x axis in the ring's plane, whatever the
+                       ring's own x axis; an arc's spread over it, ends included), slots 6-7 the
+                       two lowest local minima over the ring angle of its distance to the
+                       solid (its lowest point over the face, its nearest point to the edge
+                       beyond it, the two crossings of a ring lying across the edge), found on
+                       24 samples per turn and refined by Brent's method to 1e-9 rad; a slot
+                       without a minimum takes the ring's highest sample that is not a support
+                       point. Inside the solid a bare ring's deepest point takes the normal of
+                       the nearest face (no gradient where two are equally near); a contact
+                       offset d makes the gap that of the tube of radius d about the ring, whose
+                       normal stays continuous while the penetration is below d.
 circle-bore       0-1  ring INSIDE a bore: g = R_bore - (largest distance of a ring point from
 arc-bore               the bore axis), n radially outward from that ring point (parallel axes at
                        eccentricity e: g = R_bore - R_ring - e). Kept only if the point on the

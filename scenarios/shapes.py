@@ -15,9 +15,9 @@ Circle    the circle of ``radius`` in the shape's xy-plane, centred at the origi
           ring edge, as the C-60 CAD draws rings).
 Arc       the part of that circle between angles ``start_angle`` and ``end_angle`` (radians,
           measured from +x about +z, ``start_angle < end_angle <= start_angle + 2 pi``).
-Rectangle a bounded plane face: the half-space z <= 0 as for Plane, but a contact exists only
-          where its point on the face lies in |x| <= ``half_extents[0]``, |y| <=
-          ``half_extents[1]`` (a CAD plane face; no edge contact is modelled beyond it).
+Rectangle a bounded plane face (a CAD plane face), material below z = 0: its solid is the slab
+          |x| <= ``half_extents[0]``, |y| <= ``half_extents[1]``, -``depth`` <= z <= 0 (no
+          depth: unbounded below); a partner past the face's bound meets its edge.
 Disc      the same bounded by the circle x^2 + y^2 <= ``radius``^2 (a round plane face).
 Bore      a concave cylindrical surface (a hole: material OUTSIDE the radius), axis along z,
           ``radius``, bounded to |z| <= ``half_length`` and to the angles ``start_angle`` ..
@@ -161,9 +161,10 @@ def _check_angle_range(shape: Shape) -> None:
 class Rectangle(Shape):
     """A bounded plane face: |x| <= half_x, |y| <= half_y in its frame, material below z = 0.
 
-    ``depth`` [L] is how far the solid reaches behind the face: a partner deeper than that has
-    passed behind the solid (a part that turned all the way round), it is not in it, and no
-    contact is reported. None: the whole half-space below the face.
+    ``depth`` [L] is how far the solid reaches behind the face: a partner that went round
+    behind the solid (a part that turned all the way round) meets its back, not its face.
+    None: the solid reaches down without end. Past the face's bound a partner meets its edge
+    (docs/contact-geometry.md).
     """
 
     kind: ClassVar[str] = "rectangle"

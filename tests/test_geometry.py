@@ -201,12 +201,14 @@ def test_gaps_of_hand_built_configurations(gap0):
 
 def test_circle_plane_tilted_lowest_point_closed_form():
     # Circle of radius 0.5 whose axis is tilted by 0.4 rad from the plane normal: its lowest point
-    # is 0.5 sin(0.4) below its centre.
+    # is 0.5 sin(0.4) below its centre. The kernel finds it by a minimisation over the ring
+    # angle (to 1e-9 rad): the gap, quadratic there, to round-off (a sine and a subtraction).
     gap, point_a, point_b, _ = contacts(G.PLANE, params(), (0, 0, 0), IDENTITY, G.CIRCLE,
                                         params(0.5), (0.0, 0.0, 1.0),
                                         rotation((1, 0, 0), 0.4))
-    assert abs(gap[0] - (1.0 - 0.5 * math.sin(0.4))) < 4 * EPS  # a sine and a subtraction
-    assert abs(point_b[0, 2] - gap[0]) < 4 * EPS  # the plane is z = 0: same numbers
+    lowest = int(np.argmin(gap))
+    assert abs(gap[lowest] - (1.0 - 0.5 * math.sin(0.4))) < 4 * EPS
+    assert abs(point_b[lowest, 2] - gap[lowest]) < 4 * EPS  # the plane is z = 0: same numbers
 
 
 # ------------------------------------------------------------------------------------------------
@@ -292,18 +294,39 @@ def gap_derivative(a, b, which, count):
     return derivative
 
 
+RING_FACE_PAIRS = {(face, ring) for face in (G.PLANE, G.RECTANGLE, G.DISC)
+                   for ring in (G.CIRCLE, G.ARC)}
+
+
+def kinked_candidates(pair, gap) -> np.ndarray:
+    """Candidates whose gap has no derivative: a ring's deepest point INSIDE a face's solid
+    (slots 6, 7 of kernels/gaps/ring_faces.py with a negative gap). Inside, the signed distance
+    is minus the distance to the nearest boundary face; along the ring its minimum typically
+    lies where two faces are equally near (the ring's deepest point in the corner region of an
+    edge), a corner of the function whose normal is that of one of the two faces."""
+    if pair not in RING_FACE_PAIRS and pair[::-1] not in RING_FACE_PAIRS:
+        return np.zeros(gap.shape[0], dtype=bool)
+    return (np.arange(gap.shape[0]) >= 6) & (gap < 0.0)
+
+
 @pytest.mark.parametrize("pair", DIFFERENTIABLE_PAIRS, ids=pair_id)
 def test_gap_derivative_is_the_normal(pair):
     rng = np.random.default_rng(sum(pair) * 101 + pair[0])
+    checked = 0
     for _ in range(25):
         a, b = random_pair(*pair, rng)
         gap, _, _, frame = contacts(*a, *b)
         normal = frame[:, 0]
+        smooth = ~kinked_candidates(pair, gap)
+        checked += int(np.count_nonzero(smooth))
         # Central difference, step 1e-6 on O(1) geometry with curvature radius >= 0.2:
         # truncation ~ h^2 / r^2 = 2.5e-11, round-off ~ 3 eps / h = 7e-10. 1e-7 is far above both
         # and far below any wrong-normal error (O(1)).
-        assert np.allclose(gap_derivative(a, b, "b", gap.shape[0]), normal, atol=1e-7)
-        assert np.allclose(gap_derivative(a, b, "a", gap.shape[0]), -normal, atol=1e-7)
+        assert np.allclose(gap_derivative(a, b, "b", gap.shape[0])[smooth], normal[smooth],
+                           atol=1e-7)
+        assert np.allclose(gap_derivative(a, b, "a", gap.shape[0])[smooth], -normal[smooth],
+                           atol=1e-7)
+    assert checked > 0  # not vacuous (a bore drops the candidates beyond its bounds)
 
 
 def test_box_box_corner_gaps_have_the_normal_as_derivative():
@@ -472,20 +495,23 @@ def test_arc_excluding_the_nearest_point_returns_its_nearer_end():
 def test_arc_plane_returns_the_lower_end_when_the_lowest_point_is_outside():
     # Upright circle: turned 90 degrees about x, its x axis stays along x and its y axis points
     # up (+z), so the point at angle t is sin(t) radii above the centre; lowest at t = -pi/2.
-    # An arc over [0, 2] excludes it: the lower end is t = 0 (at the centre's height).
-    # Bounds: 4 ulp, one sine / cosine of the angle and a sum.
+    # An arc over [0, 2] excludes it: the lower end is t = 0 (at the centre's height), the
+    # arc's first support point. Bounds: 4 ulp, one sine / cosine of the angle and a sum.
     upright = rotation((1, 0, 0), math.pi / 2)
     gap, _, point_b, _ = contacts(G.PLANE, params(), np.zeros(3), IDENTITY, G.ARC,
                                   params(0.5, 0.0, 2.0), np.array([0.0, 0.0, 1.0]), upright)
-    assert abs(gap[0] - 1.0) < 4 * EPS and np.allclose(point_b[0], [0.5, 0.0, 1.0], atol=4 * EPS)
+    lowest = int(np.argmin(gap))
+    assert abs(gap[lowest] - 1.0) < 4 * EPS
+    assert np.allclose(point_b[lowest], [0.5, 0.0, 1.0], atol=4 * EPS)
     # [1.5, 4]: height sin(4) = -0.757 < sin(1.5): the end at t = 4.
     gap = contacts(G.PLANE, params(), np.zeros(3), IDENTITY, G.ARC, params(0.5, 1.5, 4.0),
                    np.array([0.0, 0.0, 1.0]), upright)[0]
-    assert abs(gap[0] - (1.0 + 0.5 * math.sin(4.0))) < 4 * EPS
-    # An arc that contains -pi/2 (as 3 pi/2) returns the true lowest point.
+    assert abs(gap.min() - (1.0 + 0.5 * math.sin(4.0))) < 4 * EPS
+    # An arc that contains -pi/2 (as 3 pi/2) returns the true lowest point (minimised over the
+    # angle: the gap, quadratic there, to round-off).
     gap = contacts(G.PLANE, params(), np.zeros(3), IDENTITY, G.ARC, params(0.5, 1.0, 5.0),
                    np.array([0.0, 0.0, 1.0]), upright)[0]
-    assert abs(gap[0] - 0.5) < 4 * EPS
+    assert abs(gap.min() - 0.5) < 4 * EPS
 
 
 # ------------------------------------------------------------------------------------------------

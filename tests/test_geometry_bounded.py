@@ -1,5 +1,6 @@
 """Bounded plane faces (rectangle, disc) and bores (ring or journal inside a hole): gap signs,
-face and patch bounds, swap symmetry and gap derivatives on configurations that touch."""
+the face's solid beyond its bound and behind it, patch bounds, swap symmetry and gap
+derivatives on configurations that touch."""
 
 import math
 
@@ -49,13 +50,16 @@ HAND = 64 * EPS
 @pytest.mark.parametrize("face", [G.RECTANGLE, G.DISC], ids=["rectangle", "disc"])
 def test_bounded_faces_give_the_plane_gap_inside_the_face(face, gap0):
     face_params = params(1.0, 0.5) if face == G.RECTANGLE else params(1.0)
-    # An arc standing on the face (its plane vertical), lowest point at height gap0.
+    # An arc standing on the face (its plane vertical), lowest point at height gap0: far from
+    # the face's bound, its deepest candidate is the plane's. The kernel minimises over the
+    # ring angle (to 1e-9 rad): the gap, quadratic there, to round-off.
     arc = (G.ARC, params(0.3, math.pi, 2 * math.pi), (0.2, 0.1, 0.3 + gap0),
            rotation((1, 0, 0), math.pi / 2))
     gap, point_a, point_b, frame = contacts(face, face_params, np.zeros(3), IDENTITY, *arc)
-    assert gap.shape == (1,) and abs(gap[0] - gap0) < HAND
-    assert np.allclose(frame[0, 0], [0, 0, 1], atol=4 * EPS)
-    assert np.allclose(point_a[0], [0.2, 0.1, 0.0], atol=HAND)
+    lowest = int(np.argmin(gap))
+    assert gap.shape == (8,) and abs(gap[lowest] - gap0) < HAND
+    assert np.allclose(frame[lowest, 0], [0, 0, 1], atol=4 * EPS)
+    assert np.allclose(point_a[lowest], [0.2, 0.1, 0.0], atol=HAND)
     # A lying cylinder: its two lowest rim points (both over the face) at height gap0.
     cylinder = (G.CYLINDER, params(0.2, 0.3), (0.1, 0.0, 0.2 + gap0),
                 rotation((1, 0, 0), math.pi / 2))
@@ -63,19 +67,27 @@ def test_bounded_faces_give_the_plane_gap_inside_the_face(face, gap0):
     assert np.all(np.abs(np.sort(gap)[:2] - gap0) < HAND)
 
 
-def test_rectangle_keeps_only_the_candidates_over_the_face():
+def test_beyond_the_faces_bound_a_partner_meets_its_edge():
     rectangle = (G.RECTANGLE, params(1.0, 0.5), np.zeros(3), IDENTITY)
-    # Sphere centre over the face, then just beyond its x edge.
-    inside = contacts(*rectangle, G.SPHERE, params(0.1), (0.999, 0.0, 0.2), IDENTITY)[0]
-    outside = contacts(*rectangle, G.SPHERE, params(0.1), (1.001, 0.0, 0.2), IDENTITY)[0]
-    assert inside.shape == (1,) and outside.shape == (0,)
-    # A cylinder lying along x across the edge x = 1: of the 8 rim candidates, only those of the
-    # end over the face (x = 0.6) are kept; the other end (x = 1.4) is off the face.
+    # Sphere centre over the face, then just beyond its x edge: the face's solid (the prism
+    # |x| <= 1, |y| <= 0.5, z <= 0) is nearest at its edge (1, 0, 0), at the distance
+    # hypot(0.001, 0.2), along that direction.
+    inside = contacts(*rectangle, G.SPHERE, params(0.1), (0.999, 0.0, 0.2), IDENTITY)
+    outside = contacts(*rectangle, G.SPHERE, params(0.1), (1.001, 0.0, 0.2), IDENTITY)
+    assert abs(inside[0][0] - 0.1) < HAND and np.allclose(inside[3][0, 0], [0, 0, 1])
+    distance = math.hypot(0.001, 0.2)
+    assert abs(outside[0][0] - (distance - 0.1)) < HAND
+    assert np.allclose(outside[3][0, 0], [0.001 / distance, 0.0, 0.2 / distance], atol=HAND)
+    assert np.allclose(outside[1][0], [1.0, 0.0, 0.0], atol=HAND)
+    # A cylinder lying along x across the edge x = 1, resting on it: the 8 rim candidates keep
+    # their slots; the end over the face (x = 0.6) touches it, the end beyond (x = 1.4) is at
+    # its distance from the edge line.
     lying = contacts(*rectangle, G.CYLINDER, params(0.1, 0.4), (1.0, 0.0, 0.1),
                      rotation((0, 1, 0), math.pi / 2))
     gap, point_a = lying[0], lying[1]
-    assert 0 < gap.shape[0] < 8
-    assert np.all(np.abs(point_a[:, 0]) <= 1.0) and np.all(np.abs(point_a[:, 1]) <= 0.5)
+    assert gap.shape[0] == 8
+    assert np.all(np.abs(point_a[:, 0]) <= 1.0 + HAND) and np.all(np.abs(point_a[:, 1]) <= 0.5)
+    assert abs(gap.min()) < HAND  # the lowest rim point over the face rests on it
 
 
 def test_disc_is_round_and_rectangle_is_not():
@@ -84,7 +96,9 @@ def test_disc_is_round_and_rectangle_is_not():
                       params(0.1), corner, IDENTITY)[0]
     disc = contacts(G.DISC, params(1.0), np.zeros(3), IDENTITY, G.SPHERE, params(0.1), corner,
                     IDENTITY)[0]
-    assert square.shape == (1,) and disc.shape == (0,)
+    # Over the square: its height 0.2; beside the disc: its distance to the disc's rim circle.
+    assert abs(square[0] - 0.1) < HAND
+    assert abs(disc[0] - (math.hypot(math.hypot(0.9, 0.9) - 1.0, 0.2) - 0.1)) < HAND
 
 
 @pytest.mark.parametrize("ring_first", [True, False])
@@ -319,22 +333,23 @@ def test_swapping_mirrors_and_derivatives_are_the_normal(pair):
 
 
 @pytest.mark.parametrize("face", [G.RECTANGLE, G.DISC], ids=["rectangle", "disc"])
-def test_a_face_with_a_depth_ignores_partners_behind_its_solid(face):
-    # Packed depth 0.5 (third parameter of a rectangle, second of a disc): a sphere 0.4 deep
-    # is in the solid (a contact), one 0.6 deep has passed behind it (none); without a depth
-    # (packed 0) the face bounds a half-space and both are contacts.
+def test_a_face_with_a_depth_is_a_slab(face):
+    # Packed depth 0.5 (third parameter of a rectangle, second of a disc): the solid is the
+    # slab -0.5 <= z <= 0. A sphere (radius 0.1) whose centre is 0.2 deep is nearer the top
+    # (gap -0.3 along +z); one 0.3 deep is nearer the back (0.2 from it: gap -0.3 along -z);
+    # one gone behind the slab, centre 0.7 deep, is 0.2 from the back (gap 0.1 along -z).
+    # Without a depth (packed 0) the solid reaches down without end: the 0.3 deep sphere is
+    # then nearest the top (0.3, nearer than the sides, 0.4 and more).
     def face_params(depth):
         return params(1.0, 0.5, depth) if face == G.RECTANGLE else params(1.0, depth)
 
-    for depth, expected in ((0.5, (1, 0)), (0.0, (1, 1))):
-        counts = []
-        for penetration in (0.4, 0.6):
-            gap = contacts(face, face_params(depth), np.zeros(3), IDENTITY, G.SPHERE,
-                           params(0.1), (0.2, 0.1, 0.1 - penetration), IDENTITY)[0]
-            counts.append(gap.shape[0])
-            if gap.shape[0]:
-                assert abs(gap[0] + penetration) < HAND
-        assert tuple(counts) == expected
+    cases = ((0.5, 0.2, -0.3, 1.0), (0.5, 0.3, -0.3, -1.0), (0.5, 0.7, 0.1, -1.0),
+             (0.0, 0.3, -0.4, 1.0))
+    for depth, centre_depth, expected_gap, normal_z in cases:
+        gap, _, _, frame = contacts(face, face_params(depth), np.zeros(3), IDENTITY, G.SPHERE,
+                                    params(0.1), (0.2, 0.1, -centre_depth), IDENTITY)
+        assert abs(gap[0] - expected_gap) < HAND
+        assert np.allclose(frame[0, 0], [0.0, 0.0, normal_z], atol=4 * EPS)
 
 
 def test_face_depth_is_packed_and_validated():

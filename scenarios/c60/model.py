@@ -28,6 +28,18 @@ reduced to a shape:
   frame's faces (no material data); a single face must face its partner (checked);
 * arc (a half ring standing for a rounded edge) -> :class:`~.shapes.Arc`; stray points dropped.
 
+The latch's edge (``latch_edge``, :mod:`.variants`). The tripping bar's latch corner, where the
+hook's latch face rests (C4_3, C4_4), is a half ring of 0.5 mm in the source's arc files, a
+sharp corner in the bar's solid, and rounded by a convex r 0.05 mm fillet in the source's wedge
+file (C4_1, C4_2). By default (``fillet``) the half ring's centre line is moved onto that
+fillet's axis and the fillet's radius is added to the pair's offset: the pair's gap is then the
+gap of the torus of that radius about the moved half ring, whose section at the contact is the
+fillet's. Against the face's solid (its free edge sharp, as in the hook's solid) the gap and
+normal stay continuous while the bar's corner slides off the face's edge. ``face-normal`` keeps
+the source's bare half rings and continues the hook's face past its free edge by
+:data:`FACE_NORMAL_EXTENSION` (the face's normal and plane gap there, as the source's CAD
+distance takes them). docs/c60.md states the CAD evidence.
+
 A surface made of several faces (the C4 wedge of the tripping bar: side plane, top plane,
 concave hollow, convex fillet) gives one contact pair per face, named ``<pair>_<face>``: the
 source takes one minimum distance over the composite surface, the union of per-face pairs
@@ -73,6 +85,7 @@ measurement pairs of the sheet as point distances (see :data:`FUNCTIONAL_CONDITI
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 import tomllib
@@ -119,6 +132,16 @@ Z_AXIS = (0.0, 0.0, 1.0)
 #: bar's C4 partners leave the hook's concave hollow (a partial bore) round behind it, 13.4 mm
 #: "deep" at 19.62 ms of c60-trip, and the projection moved the parts 6.4 mm in one step.
 FACE_DEPTH = 0.5
+#: The latch pairs whose tripping-bar arc (a half ring of 0.5 mm about the bar's latch corner,
+#: ``REVISED_CAD3/C4/Tbar_half_ring_C4_*``) meets the hook's latch face
+#: (``REVISED_CAD1/C4/Hook_Tbar_C4_surface``), and the file of the source that rounds that corner
+#: (the wedge surface of C4_1/C4_2: its ``fillet`` face, r 0.05 mm about the corner).
+LATCH_CORNER_CONTACTS = ("Hook_Tbar_C4_3", "Hook_Tbar_C4_4")
+LATCH_FILLET_FILE = "C60/C4/Tbar_hook_wedge_surface_C4.stp"
+#: How far ``latch_edge="face-normal"`` continues the hook's latch face past its free edge [mm]:
+#: 20 times the face's width, beyond any motion of the bar's arc over it before the latch has
+#: let go (the source's CAD distance continues the face's normal without end).
+FACE_NORMAL_EXTENSION = 10.0
 
 
 @lru_cache(maxsize=1)
@@ -404,6 +427,8 @@ def _contact_geometry(offsets: Mapping[str, float], poses: Mapping[str, Pose],
                 bore = isinstance(primitive, prim.Cylinder) and _is_bore(
                     primitive, poses[body], partner, partner_pose)
                 shape = _shape(name, primitive, toward, poses[body], len(items) == 1, bore)
+                if contact["name"] in LATCH_CORNER_CONTACTS:
+                    shape = _latch_edge_shape(shape, parameters.latch_edge)
                 known = shapes[body].get(name)
                 if known is not None and known != shape:
                     raise ValueError(f"shape {name} of {body} differs between two contacts")
@@ -418,8 +443,52 @@ def _contact_geometry(offsets: Mapping[str, float], poses: Mapping[str, Pose],
                     body_a=contact["body1"], shape_a=shape_a, body_b=contact["body2"],
                     shape_b=shape_b, friction=friction,
                     restitution=float(contact["restitution"]),
-                    offset=offsets[contact["name"]]))
+                    offset=offsets[contact["name"]] + _latch_offset(contact["name"],
+                                                                    parameters.latch_edge)))
     return shapes, pairs
+
+
+def latch_fillet() -> prim.Cylinder:
+    """The fillet face of the tripping bar's wedge surface (:data:`LATCH_FILLET_FILE`): the
+    convex r 0.05 mm cylinder about the bar's latch corner (bar frame)."""
+    faces = dict(zip(WEDGE_FACES, _contact_primitives(LATCH_FILLET_FILE), strict=True))
+    fillet = faces["fillet"]
+    if not isinstance(fillet, prim.Cylinder) or fillet.radius > 0.1:
+        raise ValueError(f"{LATCH_FILLET_FILE}: its fourth face is not the corner's fillet")
+    return fillet
+
+
+def _latch_offset(contact_name: str, latch_edge: str) -> float:
+    """What ``latch_edge`` adds to a latch pair's offset [mm]: the fillet's radius (the
+    tube's) for ``fillet``, nothing otherwise."""
+    if contact_name in LATCH_CORNER_CONTACTS and latch_edge == "fillet":
+        return latch_fillet().radius
+    return 0.0
+
+
+def _latch_edge_shape(shape: Shape, latch_edge: str) -> Shape:
+    """A latch pair's shape under ``latch_edge`` (module docstring): the bar's half ring
+    moved onto the fillet's axis (``fillet``), or the hook's face continued past its free edge
+    (``face-normal``); the other side as it is."""
+    if isinstance(shape, Arc) and latch_edge == "fillet":
+        fillet = latch_fillet()
+        rotation = _quaternions().quat_to_matrix(np.asarray(shape.orientation, dtype=float))
+        middle = 0.5 * (shape.start_angle + shape.end_angle)
+        apex = np.asarray(shape.position) + shape.radius * (
+            math.cos(middle) * rotation[:, 0] + math.sin(middle) * rotation[:, 1])
+        axis = np.asarray(fillet.axis, dtype=float)
+        offset = apex - np.asarray(fillet.axis_point, dtype=float)
+        on_axis = apex - (offset - (offset @ axis) * axis)
+        return dataclasses.replace(shape, position=tuple(
+            float(c) for c in np.asarray(shape.position) + on_axis - apex))
+    if isinstance(shape, Rectangle) and latch_edge == "face-normal":
+        rotation = _quaternions().quat_to_matrix(np.asarray(shape.orientation, dtype=float))
+        half_x, half_y = shape.half_extents
+        # The face's free edge is its -x edge (the edge against the C5 surface, docs/c60.md).
+        centre = np.asarray(shape.position) - 0.5 * FACE_NORMAL_EXTENSION * rotation[:, 0]
+        return dataclasses.replace(shape, position=tuple(float(c) for c in centre),
+                                   half_extents=(half_x + 0.5 * FACE_NORMAL_EXTENSION, half_y))
+    return shape
 
 
 def _bodies(shapes: Mapping[str, Mapping[str, Shape]]) -> list[Body]:

@@ -12,17 +12,19 @@ in comments beside the values it uses, the values of other versions of its laws:
 * its force on the plate, ``M / lever``: 5.48 mm (used, "updated 26 May 2015"), "5(old plugin
   value validated)".
 
-The handle spring's point of application (``handle_spring_arm``, ``source`` or ``design``) is
-described in :mod:`.model`. Friction is given per contact class (:data:`CONTACT_CLASSES`): the
-source's values (0.2 on the hook/tripping-bar latch C4 and the needle bearing S3, 0.1
-elsewhere), or ``paper-table-4``: each pair at the paper's Table 4 value for its two materials
-(plastic/plastic 0.3, metal/plastic 0.1), the materials established in :data:`PART_MATERIALS`.
-Table 4 gives no metal/metal value: the one metal/metal pair (C7, the two electrical contacts)
+The handle spring's point of application (``handle_spring_arm``, ``source`` or ``design``) and
+the latch's edge (``latch_edge``, :data:`LATCH_EDGES`) are described in :mod:`.model`. Friction
+is given per contact class (:data:`CONTACT_CLASSES`): the source's values (0.2 on the
+hook/tripping-bar latch C4 and the needle bearing S3, 0.1 elsewhere), or ``paper-table-4``:
+each pair at the paper's Table 4 value for its two materials (plastic/plastic 0.3,
+metal/plastic 0.1), the materials established in :data:`PART_MATERIALS`. Table 4 gives no
+metal/metal value: the one metal/metal pair (C7, the two electrical contacts)
 keeps the source's 0.1.
 
 :func:`model_parameters` resolves a named variant (:data:`VARIANTS`) plus explicit overrides
 into a :class:`ModelParameters`, and refuses a bad value naming the field before any scene is
-built. The defaults are the source's model.
+built. The defaults are the source's model, with the latch corner's fillet from the CAD where
+the source's two files of it differ (``latch_edge``).
 """
 
 from __future__ import annotations
@@ -36,6 +38,12 @@ from clearbench.scenarios.validation import SceneError
 #: Friction sets: the source's per-pair values, or the paper's Table 4 by materials.
 FRICTION_SETS = ("source", "paper-table-4")
 HANDLE_SPRING_ARMS = ("source", "design")
+#: How the hook's latch face meets the tripping bar's latch corner past the face's free edge
+#: (the C4_3 and C4_4 pairs, :mod:`.model`): ``fillet`` (default), the bar's corner rounded by
+#: the r 0.05 mm fillet of the source's wedge file against the face's sharp edge, the edge of the
+#: face's solid; ``face-normal``, the source's bare arcs against the face continued past its
+#: free edge (its normal and plane gap there, as the source's CAD distance takes them).
+LATCH_EDGES = ("fillet", "face-normal")
 #: Contact classes (the prefix every sheet contact of the class carries in its name).
 CONTACT_CLASSES = ("J1", "J2", "J3", "J4", "J5", "J6", "J7", "S3", "C1", "C3", "C4", "C5",
                    "C6", "C7", "TRIP", "FC_X", "plunger_bearing")
@@ -83,6 +91,7 @@ class ModelParameters:
     contact_spring_angle_offset : deg, in [-90, -60]
     moving_contact_force_lever, plate_force_lever : mm, in [1, 20]
     handle_spring_arm : ``source`` or ``design``
+    latch_edge : ``fillet`` or ``face-normal`` (:data:`LATCH_EDGES`; ``fillet`` is the CAD's)
     friction_set : ``source`` or ``paper-table-4`` (the base value of every pair)
     friction : sorted (contact class, coefficient) pairs overriding the base, each in [0, 1]
     """
@@ -92,6 +101,7 @@ class ModelParameters:
     moving_contact_force_lever: float = 6.06
     plate_force_lever: float = 5.48
     handle_spring_arm: str = "source"
+    latch_edge: str = "fillet"
     friction_set: str = "source"
     friction: tuple[tuple[str, float], ...] = ()
 
@@ -127,6 +137,7 @@ VARIANTS: dict[str, dict] = {
     "lever-7.99": {"moving_contact_force_lever": 7.99},
     "old-validated-levers": {"moving_contact_force_lever": 4.84, "plate_force_lever": 5.0},
     "design-arm": {"handle_spring_arm": "design"},
+    "latch-face-normal": {"latch_edge": "face-normal"},
     "paper-table-4": {"friction_set": "paper-table-4"},
     "latch-0.1": {"friction": {"C4": 0.1}},
     "preload-0.9599-lever-4.84": {"contact_spring_preload": 0.9599,
@@ -195,6 +206,8 @@ def model_parameters(variant: str = "source", **overrides) -> ModelParameters:
             checked[name] = _number(name, value)
         elif name == "handle_spring_arm":
             checked[name] = _choice(name, value, HANDLE_SPRING_ARMS)
+        elif name == "latch_edge":
+            checked[name] = _choice(name, value, LATCH_EDGES)
         elif name == "friction_set":
             checked[name] = _choice(name, value, FRICTION_SETS)
         else:

@@ -14,17 +14,17 @@ plane-sphere        1   centre height minus radius
 plane-box           8   every corner
 plane-capsule       2   the two end spheres
 plane-cylinder      8   four rim points on each end rim (indices 0, 1: the two lowest)
-plane-circle        1   lowest point of the circle
-plane-arc           1   lowest point of the arc (or its lower end)
+plane-circle        8   6 support points and the 2 deepest points of the ring (kernels/gaps/
+plane-arc           8   ring_faces.py)
 sphere-sphere       1   centre distance minus radii
 box-sphere          1   closest point of the solid box
 capsule-sphere      1   closest point of the axis segment
 cylinder-sphere     1   closest point of the solid cylinder
 circle-cylinder     1   ring against the (infinitely long) lateral surface of a journal
 arc-cylinder        1   the same, restricted to the arc
-rectangle-X         as  plane-X for X = sphere (1), cylinder (8), circle (1), arc (1); a
-disc-X              ..  candidate whose point is off the face, or deeper than its depth, is
-                        dropped
+rectangle-X         as  plane-X for X = sphere (1), cylinder (8), circle (8), arc (8), each
+disc-X              ..  candidate's gap its distance to the face's solid (the edge beyond the
+                        face's bound): never dropped
 circle-bore         1   ring point farthest from the bore axis; dropped outside the bore's
 arc-bore            1   angles or beyond its length
 cylinder-bore       2   one per end of the axial overlap (slot 0 at the bore's -z side);
@@ -49,38 +49,20 @@ SPHERE, BOX, CAPSULE, CYLINDER, PLANE, CIRCLE, ARC, RECTANGLE, DISC, BORE = (
 SHAPE_KINDS = gaps.SHAPE_KIND_NAMES
 
 #: Canonical pairs (kind on A, kind on B) -> number of slots; reversed orders are mirrored.
+#: Derived from the kernels' one declaration of the pairs and their slots
+#: (:data:`clearbench.kernels.gaps.PAIR_SLOTS`); a pair whose number of candidates changes
+#: with the configuration (slots None there) is not supported here (:data:`NOT_PORTED`).
 CANONICAL_PAIRS = {
-    (PLANE, SPHERE): 1,
-    (PLANE, BOX): 8,
-    (PLANE, CAPSULE): 2,
-    (PLANE, CYLINDER): 8,
-    (PLANE, CIRCLE): 1,
-    (PLANE, ARC): 1,
-    (SPHERE, SPHERE): 1,
-    (BOX, SPHERE): 1,
-    (CAPSULE, SPHERE): 1,
-    (CYLINDER, SPHERE): 1,
-    (CIRCLE, CYLINDER): 1,
-    (ARC, CYLINDER): 1,
-    (RECTANGLE, SPHERE): 1,
-    (RECTANGLE, CYLINDER): 8,
-    (RECTANGLE, CIRCLE): 1,
-    (RECTANGLE, ARC): 1,
-    (DISC, SPHERE): 1,
-    (DISC, CYLINDER): 8,
-    (DISC, CIRCLE): 1,
-    (DISC, ARC): 1,
-    (CIRCLE, BORE): 1,
-    (ARC, BORE): 1,
-    (CYLINDER, BORE): 2,
+    (SHAPE_KINDS[kind_a], SHAPE_KINDS[kind_b]): slots
+    for (kind_a, kind_b), slots in gaps.PAIR_SLOTS.items() if slots is not None
 }
-#: Gap [L] the worker hands Siconos for a dropped slot (a candidate off a bounded face, deeper
-#: than its depth, outside a bore's angles or length): far beyond any activation threshold
+#: Gap [L] the worker hands Siconos for a dropped slot (a candidate outside a bore's angles or
+#: length, or deeper than its depth): far beyond any activation threshold
 #: (y + h/2 y' <= ~1e-10 of the smallest feature), so the interaction stays inactive until the
 #: candidate comes back; finite, so Siconos's norms of the outputs stay finite.
 DROPPED_GAP = 1e12
-#: Shape kinds whose pairs can drop candidates (a bounded face, a bore).
-DROPPING_KINDS = (RECTANGLE, DISC, BORE)
+#: Shape kinds whose pairs can drop candidates (a bore): the kernels' DROPPING_KINDS.
+DROPPING_KINDS = tuple(SHAPE_KINDS[kind] for kind in gaps.DROPPING_KINDS)
 
 #: Why the pairs of the shared geometry that the worker does not support are missing.
 NOT_PORTED = {

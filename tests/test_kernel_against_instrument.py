@@ -1,0 +1,299 @@
+"""Every pair type of the gap kernel against the independent instrument, on random configurations
+drawn to include the hard places.
+
+The kernel (:func:`clearbench.scenarios.geometry.contacts_between`) and the instrument
+(:func:`clearbench.harness.measure.instrument.independent_gap`, which shares no code with it)
+read the same solids (docs/contact-geometry.md). The instrument's reading is a witnessed signed
+distance ``gap`` with a ``resolution``: the true value G (the signed distance of the deepest,
+or closest, boundary point of one shape to the other's solid) lies in [gap - resolution, gap].
+The kernel's figure is its smallest candidate gap (+inf without a candidate). What must hold,
+give or take TOLERANCE (round-off, and the kernel's minimisation over a ring's angle):
+
+- EXACT pairs (a plane against anything, a ring or arc against a face, a cylinder or a bore):
+  the kernel's candidates are boundary points with their exact signed distances and its
+  smallest is G: it lies in [gap - resolution, gap].
+- SEPARATION pairs (two solids: spheres, boxes against spheres, capsules, a sphere against a
+  face's slab, a journal in a bore): the kernel's gap is a separation distance, the translation
+  that parts the two solids. Separated, that is their distance, G; overlapping it is at least
+  the depth of the deepest point (a point that deep needs that much motion) and can be more
+  once a shape's centre is inside the other (two balls: r_a + r_b - d against the depth of B's
+  boundary point nearest A's centre). So: the kernel sees at least the witnessed penetration
+  (smallest <= gap), and equals G when the instrument says separated.
+- BOXES: two boxes take the depth along a reference face's normal (clipping): the kernel sees
+  at least the witnessed penetration; separated it may report no candidate (boxes side by
+  side diagonally) or a height along that normal, which is below their distance.
+- RIMS (a cylinder against a bounded face): its candidates are its eight rim points, boundary
+  points, so none is deeper than the instrument's lower bound (no phantom); its lateral surface
+  lying across the face's edge is not a candidate (a stated limitation of
+  :mod:`clearbench.kernels.gaps.faces`), so nothing is asserted on the other side.
+
+Configurations: A's body at a random pose, B's placed relative to it in A's frame near the
+places that break kernels (a ring or arc across a face's bound, an arc's ends, a disc's rim, a
+ring lying flat, a journal past a bore's end or its depth, boxes edge to edge), both pair orders.
+Hypothesis prints the failing example. The default suite draws QUICK_EXAMPLES per pair and
+order; ``-m slow`` runs THOROUGH_EXAMPLES.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from clearbench.harness.measure.instrument import independent_gap
+from clearbench.scenarios.geometry import contacts_between
+from clearbench.scenarios.shapes import (
+    Arc,
+    Bore,
+    Box,
+    Capsule,
+    Circle,
+    Cylinder,
+    Disc,
+    Plane,
+    Rectangle,
+    Sphere,
+)
+
+#: Examples per pair and order in the default suite (25 pairs x 2 orders: about 10 s).
+QUICK_EXAMPLES = 6
+#: Examples per pair and order under ``-m slow``.
+THOROUGH_EXAMPLES = 150
+#: Slack of an equality between the kernel and the instrument [L], on shapes of size 0.2-2:
+#: 1e-8 is far above round-off (1e-15) and the kernel's angle minimisation (gap error
+#: quadratic in its 1e-9 rad tolerance), far below any missed or invented contact (1e-3+).
+TOLERANCE = 1e-8
+
+#: Pairs, canonical order (A, B) as the kernel computes them, and what is asserted.
+EXACT, SEPARATION, BOXES, RIMS = "exact", "separation", "boxes", "rims"
+PAIRS = {
+    ("plane", "sphere"): EXACT, ("plane", "box"): EXACT, ("plane", "capsule"): EXACT,
+    ("plane", "cylinder"): EXACT, ("plane", "circle"): EXACT, ("plane", "arc"): EXACT,
+    ("sphere", "sphere"): SEPARATION, ("box", "sphere"): SEPARATION,
+    ("capsule", "sphere"): SEPARATION, ("cylinder", "sphere"): SEPARATION,
+    ("box", "box"): BOXES, ("capsule", "capsule"): SEPARATION,
+    ("circle", "cylinder"): EXACT, ("arc", "cylinder"): EXACT,
+    ("rectangle", "sphere"): SEPARATION, ("rectangle", "cylinder"): RIMS,
+    ("rectangle", "circle"): EXACT, ("rectangle", "arc"): EXACT,
+    ("disc", "sphere"): SEPARATION, ("disc", "cylinder"): RIMS,
+    ("disc", "circle"): EXACT, ("disc", "arc"): EXACT,
+    ("circle", "bore"): EXACT, ("arc", "bore"): EXACT, ("cylinder", "bore"): SEPARATION,
+}
+ORDERED = [(pair, swapped) for pair in PAIRS for swapped in (False, True)]
+#: Pairs whose check fails today, kept running as expected failures so the suite says when
+#: they pass: a ring or arc in a bore, both orders. Shrunk example: a ring of radius 1 in the
+#: end plane of a bore of radius 1 (z = -half_length), 0.0625 off its axis: the kernel reads
+#: the radial depth -0.0625, the instrument 0 (the ring lies on the bore's end face, where the
+#: solid's signed distance is 0): the kernel does not bound a ring's depth by the bore's ends.
+FAILING_TODAY = {("circle", "bore"), ("arc", "bore")}
+
+
+def _param(item):
+    marks = (pytest.mark.xfail(reason="ring/arc at a bore's end: the kernel reads the "
+                               "radial depth where the end face is nearer", strict=False),) \
+        if item[0] in FAILING_TODAY else ()
+    return pytest.param(item, marks=marks, id=_id(item))
+
+
+def _id(item) -> str:
+    (a, b), swapped = item
+    return f"{b}-{a}" if swapped else f"{a}-{b}"
+
+
+# -- poses -------------------------------------------------------------------------------------
+
+def _multiply(p, q) -> np.ndarray:
+    w1, x1, y1, z1 = p
+    w2, x2, y2, z2 = q
+    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
+
+
+def _rotate(q, v) -> np.ndarray:
+    return _multiply(_multiply(q, np.r_[0.0, v]), q * np.array([1.0, -1.0, -1.0, -1.0]))[1:]
+
+
+def _about(axis, angle) -> np.ndarray:
+    axis = np.asarray(axis, dtype=float)
+    axis = axis / np.linalg.norm(axis)
+    return np.r_[math.cos(0.5 * angle), math.sin(0.5 * angle) * axis]
+
+
+@st.composite
+def quaternions(draw, tilt=None):
+    """A unit quaternion: any rotation, or (``tilt`` given) a turn about z followed by a tilt of
+    at most ``tilt`` rad, exactly 0 one time in four (a ring lying flat)."""
+    spin = draw(st.floats(-math.pi, math.pi))
+    if tilt is None:
+        axis = draw(st.tuples(*[st.floats(-1.0, 1.0)] * 3).filter(
+            lambda v: np.linalg.norm(v) > 0.1))
+        return _multiply(_about(axis, draw(st.floats(-math.pi, math.pi))), _about((0, 0, 1), spin))
+    angle = draw(st.one_of(st.just(0.0), st.floats(-tilt, tilt)))
+    direction = draw(st.floats(-math.pi, math.pi))
+    return _multiply(_about((math.cos(direction), math.sin(direction), 0.0), angle),
+                     _about((0, 0, 1), spin))
+
+
+def _size(draw, low=0.2, high=1.0):
+    return draw(st.floats(low, high))
+
+
+# -- shapes and relative placements of B in A's frame ------------------------------------------
+
+def _shape(draw, kind: str, name: str):
+    if kind == "sphere":
+        return Sphere(name, radius=_size(draw))
+    if kind == "box":
+        return Box(name, half_extents=(_size(draw), _size(draw), _size(draw)))
+    if kind in ("capsule", "cylinder"):
+        cls = Capsule if kind == "capsule" else Cylinder
+        return cls(name, radius=_size(draw, 0.2, 0.6), half_length=_size(draw, 0.2, 1.0))
+    if kind == "plane":
+        return Plane(name)
+    if kind == "circle":
+        return Circle(name, radius=_size(draw, 0.3, 1.0))
+    if kind == "arc":
+        start = draw(st.floats(-math.pi, math.pi))
+        return Arc(name, radius=_size(draw, 0.3, 1.0), start_angle=start,
+                   end_angle=start + draw(st.floats(0.3, 2.0 * math.pi)))
+    depth = draw(st.one_of(st.none(), st.floats(0.2, 1.0)))
+    if kind == "rectangle":
+        return Rectangle(name, half_extents=(_size(draw, 0.5, 2.0), _size(draw, 0.5, 2.0)),
+                         depth=depth)
+    if kind == "disc":
+        return Disc(name, radius=_size(draw, 0.5, 2.0), depth=depth)
+    raise AssertionError(kind)
+
+
+def _near_face_bound(draw, face, reach):
+    """A point (face frame) near the face's bound: beyond or within it by up to ``reach``,
+    above or below its plane by up to ``reach``."""
+    if face.kind == "disc":
+        angle = draw(st.floats(-math.pi, math.pi))
+        radial = face.radius + draw(st.floats(-reach, reach))
+        xy = radial * np.array([math.cos(angle), math.sin(angle)])
+    else:
+        half_x, half_y = face.half_extents
+        sign = draw(st.sampled_from([-1.0, 1.0]))
+        across = draw(st.floats(-reach, reach))  # > 0: beyond the bound
+        if draw(st.booleans()):  # across an x bound, or a y bound
+            xy = np.array([sign * (half_x + across),
+                           draw(st.floats(-half_y - reach, half_y + reach))])
+        else:
+            xy = np.array([draw(st.floats(-half_x - reach, half_x + reach)),
+                           sign * (half_y + across)])
+    return np.r_[xy, draw(st.floats(-0.4 * reach, reach))]
+
+
+def _relative(draw, shape_a, shape_b):
+    """B's body position and quaternion in A's frame, near the hard places of the pair."""
+    kind_a, kind_b = shape_a.kind, shape_b.kind
+    size_b = getattr(shape_b, "radius", None) or max(getattr(shape_b, "half_extents", (1.0,)))
+    if kind_a in ("rectangle", "disc"):
+        return _near_face_bound(draw, shape_a, size_b), draw(quaternions(
+            tilt=draw(st.sampled_from([0.3, math.pi]))))
+    if kind_a == "plane":
+        position = np.r_[draw(st.floats(-1.0, 1.0)), draw(st.floats(-1.0, 1.0)),
+                         draw(st.floats(-0.3 * size_b, 1.2 * size_b))]
+        return position, draw(quaternions(tilt=draw(st.sampled_from([0.3, math.pi]))))
+    if kind_b == "bore":
+        # A ring or journal inside the hole, nearly coaxial, near or past its ends.
+        reach = shape_b.half_length + draw(st.floats(-0.5, 0.5))
+        position = np.r_[draw(st.floats(-0.1, 0.1)), draw(st.floats(-0.1, 0.1)),
+                         draw(st.sampled_from([-1.0, 1.0])) * reach]
+        return -position, draw(quaternions(tilt=0.2))
+    if kind_b == "cylinder" and kind_a in ("circle", "arc"):
+        # A bearing ring around the journal (or beside a pin), within the journal's length:
+        # the kernel takes the journal's lateral surface as infinitely long.
+        eccentricity = draw(st.floats(0.0, shape_a.radius + shape_b.radius + 0.2))
+        angle = draw(st.floats(-math.pi, math.pi))
+        along = draw(st.floats(-0.5, 0.5)) * max(0.0, shape_b.half_length - shape_a.radius)
+        tilt = draw(st.floats(-0.2, 0.2))
+        return (np.array([eccentricity * math.cos(angle), eccentricity * math.sin(angle),
+                          along]), _about((math.sin(angle), -math.cos(angle), 0.0), tilt))
+    # Solids: B's centre near A's surface (edges and corners of a box included).
+    size_a = getattr(shape_a, "radius", None) or max(getattr(shape_a, "half_extents", (1.0,)))
+    extent = size_a + size_b
+    position = np.array([draw(st.floats(-extent, extent)) for _ in range(3)])
+    return position, draw(quaternions())
+
+
+@st.composite
+def configurations(draw, pair):
+    """(shape A, pose A, shape B, pose B) of the canonical pair (kinds), poses of the BODIES
+    (the shapes at their bodies' origins)."""
+    shape_a = _shape(draw, pair[0], "a")
+    if pair[1] != "bore":
+        shape_b = _shape(draw, pair[1], "b")
+    else:  # sized to its journal or ring: nearly fitting, with or without a depth
+        inner = getattr(shape_a, "radius", 0.5)
+        start = draw(st.floats(-math.pi, math.pi))
+        partial = draw(st.booleans())
+        shape_b = Bore("b", radius=inner + draw(st.floats(-0.05, 0.2)),
+                       half_length=_size(draw, 0.3, 1.5), start_angle=start,
+                       end_angle=start + (draw(st.floats(0.5, 2.0 * math.pi)) if partial
+                                          else 2.0 * math.pi),
+                       depth=draw(st.one_of(st.none(), st.floats(0.1, 0.5))))
+    position_a = np.array([draw(st.floats(-1.0, 1.0)) for _ in range(3)])
+    quaternion_a = draw(quaternions())
+    relative_position, relative_quaternion = _relative(draw, shape_a, shape_b)
+    position_b = position_a + _rotate(quaternion_a, relative_position)
+    quaternion_b = _multiply(quaternion_a, relative_quaternion)
+    return shape_a, (position_a, quaternion_a), shape_b, (position_b, quaternion_b)
+
+
+def _check(pair, swapped, configuration):
+    shape_a, pose_a, shape_b, pose_b = configuration
+    if swapped:
+        shape_a, pose_a, shape_b, pose_b = shape_b, pose_b, shape_a, pose_a
+    kernel = contacts_between(shape_a, pose_a, shape_b, pose_b)
+    smallest = float(np.min(kernel.gap)) if kernel.count else math.inf
+    reading = independent_gap(shape_a, pose_a, shape_b, pose_b)
+    lower = reading.gap - reading.resolution
+    what = PAIRS[pair]
+    seen = smallest <= reading.gap + TOLERANCE
+    no_phantom = smallest >= lower - TOLERANCE
+    report = (f"kernel's smallest gap {smallest!r}, instrument's {reading.gap!r} "
+              f"(true value in [{lower!r}, {reading.gap!r}])")
+    if what == EXACT:
+        assert seen and no_phantom, report
+    elif what == SEPARATION:
+        assert seen, "the kernel misses a penetration or contact: " + report
+        if lower > 0.0:
+            assert no_phantom, "separated, the kernel's distance is not theirs: " + report
+    elif what == BOXES:
+        assert seen or (math.isinf(smallest) and reading.gap > 0.0), report
+    else:
+        assert no_phantom, "a penetration the geometry does not have: " + report
+
+
+_QUICK = settings(max_examples=QUICK_EXAMPLES, deadline=None, derandomize=True,
+                  suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+_THOROUGH = settings(max_examples=THOROUGH_EXAMPLES, deadline=None,
+                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+
+
+@pytest.mark.parametrize("item", [_param(item) for item in ORDERED])
+@_QUICK
+@given(data=st.data())
+def test_kernel_agrees_with_the_instrument(item, data):
+    pair, swapped = item
+    _check(pair, swapped, data.draw(configurations(pair), label="configuration"))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("item", [_param(item) for item in ORDERED])
+@_THOROUGH
+@given(data=st.data())
+def test_kernel_agrees_with_the_instrument_thoroughly(item, data):
+    pair, swapped = item
+    _check(pair, swapped, data.draw(configurations(pair), label="configuration"))
+
+
+def test_every_pair_of_the_kernel_is_checked():
+    from clearbench.kernels.gaps import CANONICAL_PAIRS, SHAPE_KIND_NAMES
+
+    assert {(SHAPE_KIND_NAMES[a], SHAPE_KIND_NAMES[b]) for a, b in CANONICAL_PAIRS} == set(PAIRS)
