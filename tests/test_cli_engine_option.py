@@ -30,7 +30,7 @@ COMMANDS = [(path, parser) for path, parser in _commands(build_parser())
 #: Commands that take several engines, and what they need besides -e.
 MANY = {("sweep",): ["pendulum"], ("compare",): [], ("demo",): [], ("stability",): [],
         ("c60", "compare"): [], ("bench", "physics-table"): [], ("bench", "contact-cost"): [],
-        ("regress",): []}
+        ("regress",): [], ("view",): ["c60-trip"]}
 #: Commands that run one engine.
 ONE = {("run",): ["pendulum"], ("campaign", "run"): ["c60-paper"],
        ("campaign", "report"): ["c60-paper"], ("campaign", "status"): ["c60-paper"]}

@@ -12,6 +12,7 @@ from clearbench.harness.measure.kinds import registered
 from clearbench.harness.measure.units import figure_unit, unit_text
 from clearbench.harness.measure.verdicts import criteria_table
 from clearbench.harness.report.page import write_report
+from clearbench.harness.run.messages import WorkerRequest
 from clearbench.harness.run.spec import make_run_spec
 from clearbench.harness.run.store import ResultsStore, RunRecord, machine_info, revision_info
 from clearbench.harness.run.worker import measure_phase, run_phase
@@ -95,7 +96,8 @@ def test_it_is_tabled(free_fall):
     # off a 0.44 m fall).
     (0.0, 1, ["data-verdict='pass'", "error 0.00333 rel."]),
     # The drifting run (0.1 m/s upward): the kind's criterion against its figure, 30 mm off.
-    (0.1, 0, ["data-verdict='physics failed'", "error 0.0646 rel.",
+    # A failed cell shows the failing expectation's value against its limit.
+    (0.1, 0, ["data-verdict='physics failed'", "<span class='small'>height error 6.46 %",
               "fails fall: height error 6.46 % &gt; 1 %"]),
 ])
 def test_it_is_stored_and_reported(free_fall, tmp_path, bias, passed, shown):
@@ -104,10 +106,10 @@ def test_it_is_stored_and_reported(free_fall, tmp_path, bias, passed, shown):
     store = ResultsStore(tmp_path / "store")
     spec = make_run_spec(_falling_ball(), "fake", options={"bias": bias},
                          extra_engine_modules=FAKE)
-    request = spec.to_message() | {"trajectory_path": str(tmp_path / "run.npz")}
+    request = WorkerRequest.of(spec, str(tmp_path / "run.npz"))
     ran, scene, trajectory = run_phase(request)
     measured = measure_phase(request, scene, trajectory)
-    store.record(RunRecord.from_worker(spec, ran, measured, revision_info(), machine_info()),
+    store.record(RunRecord.from_messages(spec, ran, measured, revision_info(), machine_info()),
                  tmp_path / "run.npz", scene=spec.scene)
     row = store.get(spec.key)
     assert "fall.height_relative_error" in row["metrics"]

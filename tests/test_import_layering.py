@@ -24,9 +24,15 @@ SUBPACKAGES = ("clearbench.kernels", "clearbench.ref_solver", "clearbench.scenar
 SCENE_CONTENT = ("clearbench.scenarios.library", "clearbench.scenarios.analytic",
                  "clearbench.scenarios.c60")
 #: Shared modules of the adapters package; every other child of it is one engine's subpackage.
-ADAPTER_SHARED = frozenset({"base", "trajectory", "recording", "joint_tree", "force_elements",
-                            "energy_guard", "options", "harness_defaults",
-                            "primitive_pieces", "step_monitor"})
+def _engine_subpackages() -> frozenset[str]:
+    """The engines' subpackages of ``clearbench.adapters`` (its folders; its plain modules, base,
+    stepping, trajectory and the like, are the shared layer every engine may import)."""
+    folder = Path(importlib.util.find_spec("clearbench.adapters").origin).parent
+    return frozenset(path.name for path in folder.iterdir()
+                     if (path / "__init__.py").exists())
+
+
+ENGINE_SUBPACKAGES = _engine_subpackages()
 
 
 def _module_files() -> dict[str, Path]:
@@ -188,7 +194,7 @@ def test_adapters_import_no_harness():
 
 def _engine_subpackage(module: str) -> str | None:
     parts = module.split(".")
-    if len(parts) > 2 and parts[1] == "adapters" and parts[2] not in ADAPTER_SHARED:
+    if len(parts) > 2 and parts[1] == "adapters" and parts[2] in ENGINE_SUBPACKAGES:
         return parts[2]
     return None
 

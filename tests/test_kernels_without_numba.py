@@ -130,12 +130,22 @@ def _compare_with_compiled(plain: dict[str, np.ndarray]) -> None:
     # thousand ulp. Plain Python runs the same operations in the same order; they differ only
     # where libm and LLVM's intrinsics, or numpy's and numba's LAPACK (the roots of the
     # ring-angle quartic, polished by Newton steps afterwards), round differently.
+    # One exception, the witness points of a ring or arc against a face's solid: their slots
+    # 6..7 are minima over the ring's angle found by Brent's search (kernels/gaps/ring_faces.py),
+    # where the gap is quadratic in the angle, so the minimum's position is fixed by the gap's
+    # round-off only to sqrt(eps) ~ 1.5e-8 of the radius (<= 0.3 m here): 1e-8 m for those points,
+    # while their gaps and frames keep 1e-12 (the gap is flat there to second order).
     count = compiled["count"].astype(int)
     slots = compiled["slots"].astype(int)
+    kinds = _cases()["kinds"]
+    ring_face = {gaps.CIRCLE, gaps.ARC}, {gaps.RECTANGLE, gaps.DISC}
     for i in range(count.size):
+        pair = set(int(k) for k in kinds[i])
+        minima = bool(pair & ring_face[0]) and bool(pair & ring_face[1])
         for key in ("gap", "point_a", "point_b", "frame"):
+            bound = 1e-8 if minima and key.startswith("point") else 1e-12
             np.testing.assert_allclose(plain[key][i, :count[i]], compiled[key][i, :count[i]],
-                                       rtol=0, atol=1e-12, err_msg=f"{key}, case {i}")
+                                       rtol=0, atol=bound, err_msg=f"{key}, case {i}")
         for key in ("slot_gap", "slot_frame"):
             np.testing.assert_allclose(plain[key][i, :slots[i]], compiled[key][i, :slots[i]],
                                        rtol=0, atol=1e-12, err_msg=f"{key}, case {i}")

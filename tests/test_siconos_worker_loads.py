@@ -145,7 +145,11 @@ def test_capabilities_of_c60_state_law_loads_and_bounded_pairs():
         assert "stiffness Jacobian" in capabilities[feature].detail
     for pair in ("pair:arc-bore", "pair:bore-cylinder", "pair:cylinder-rectangle"):
         assert capabilities[pair].support is Support.NATIVE
+    # A bore drops the candidates outside its angles or length (inactive slots); a face's solid
+    # (kernels/gaps/face_solids.py) keeps every slot, past its bound too.
+    for pair in ("pair:arc-bore", "pair:bore-cylinder"):
         assert "inactive" in capabilities[pair].detail
+    assert "inactive" not in capabilities["pair:cylinder-rectangle"].detail
 
 
 def test_unknown_features_are_unsupported(monkeypatch):
@@ -167,15 +171,16 @@ def test_unknown_features_are_unsupported(monkeypatch):
 
 def test_projection_refuses_pairs_that_drop_candidates():
     """The combined projection pulls active contacts to y = 0 as equalities: a dropped slot
-    (gap 1e12) would be pulled back, so bounded faces and bores are unsupported with it, by
-    preset and by option; the default preset keeps them."""
+    (gap 1e12) would be pulled back, so bores are unsupported with it, by preset and by option;
+    the default preset keeps them."""
     scene = get_scene("c60-on")
     capabilities = siconos_engine.create("projection").capabilities(scene)
-    for pair in ("pair:arc-bore", "pair:cylinder-rectangle"):
-        assert capabilities[pair].support is Support.UNSUPPORTED
-        assert "index set 2" in capabilities[pair].detail
-    # Pairs that never drop a candidate stay supported with projection.
-    assert capabilities["pair:circle-cylinder"].support is Support.NATIVE
+    assert capabilities["pair:arc-bore"].support is Support.UNSUPPORTED
+    assert "index set 2" in capabilities["pair:arc-bore"].detail
+    # Pairs that never drop a candidate stay supported with projection: a face's solid keeps
+    # every slot past its bound.
+    for pair in ("pair:circle-cylinder", "pair:cylinder-rectangle"):
+        assert capabilities[pair].support is Support.NATIVE
     trajectory = siconos_engine.create("projection").run(scene)
     assert trajectory.status is RunStatus.UNSUPPORTED and "CombinedProjection" in trajectory.message
     # Switched on by an option: refused before any worker starts.

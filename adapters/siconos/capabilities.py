@@ -46,7 +46,7 @@ _EXPLICIT_FORCES = {
 PROJECTION_DROPPED_SLOTS = (
     "TimeSteppingCombinedProjection projects the active contacts with a positive reaction "
     "(index set 2) as equalities (it iterates while |y| >= tolerance): a candidate dropped "
-    "(off a bounded face, outside a bore) while active is pulled back from its inactive gap; "
+    "(outside a bore) while active is pulled back from its inactive gap; "
     "c60-trip diverged at 2.15 ms, the hook and the tripping bar thrown 1e10 mm apart")
 
 

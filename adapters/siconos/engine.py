@@ -17,7 +17,7 @@ Presets (each a separate engine variant ``siconos[preset]`` in results):
 - ``projection``: the same with the combined projection scheme
   (``MoreauJeanCombinedProjectionOSI`` + ``TimeSteppingCombinedProjection``; enumerative MLCP
   projection on the active set, tolerance 1e-8 x the scene's smallest feature length). It
-  refuses pairs that drop candidates (bounded faces, bores): see
+  refuses pairs that drop candidates (bores): see
   :data:`.capabilities.PROJECTION_DROPPED_SLOTS`.
 - ``nsn-ac``: as ``default`` with the semismooth Newton (Alart-Curnier) fc3d solver; scenes
   with ideal joints use ``GenericMechanical``, whose only solver is NSGS over its blocks, with
