@@ -133,8 +133,10 @@ def _compare_with_compiled(plain: dict[str, np.ndarray]) -> None:
     # One exception, the witness points of a ring or arc against a face's solid: their slots
     # 6..7 are minima over the ring's angle found by Brent's search (kernels/gaps/ring_faces.py),
     # where the gap is quadratic in the angle, so the minimum's position is fixed by the gap's
-    # round-off only to sqrt(eps) ~ 1.5e-8 of the radius (<= 0.3 m here): 1e-8 m for those points,
-    # while their gaps and frames keep 1e-12 (the gap is flat there to second order).
+    # round-off only to sqrt(eps) ~ 1.5e-8 of the radius (<= 0.3 m here): 1e-8 m for those
+    # points. Their gaps keep 1e-12 (the gap is flat there to second order); their frames, past
+    # a face's edge the direction from the edge to the point, turn by at most the point's
+    # difference over the gap: 1e-8 m / |gap| (|gap| taken no smaller than 1e-4 m).
     count = compiled["count"].astype(int)
     slots = compiled["slots"].astype(int)
     kinds = _cases()["kinds"]
@@ -142,13 +144,17 @@ def _compare_with_compiled(plain: dict[str, np.ndarray]) -> None:
     for i in range(count.size):
         pair = set(int(k) for k in kinds[i])
         minima = bool(pair & ring_face[0]) and bool(pair & ring_face[1])
+        smallest_gap = max(float(np.min(np.abs(compiled["gap"][i, :count[i]]), initial=1.0)),
+                           1e-4)
+        frame_bound = 1e-12 + 1e-8 / smallest_gap if minima else 1e-12
         for key in ("gap", "point_a", "point_b", "frame"):
-            bound = 1e-8 if minima and key.startswith("point") else 1e-12
+            bound = {"gap": 1e-12, "frame": frame_bound}.get(key, 1e-8 if minima else 1e-12)
             np.testing.assert_allclose(plain[key][i, :count[i]], compiled[key][i, :count[i]],
                                        rtol=0, atol=bound, err_msg=f"{key}, case {i}")
         for key in ("slot_gap", "slot_frame"):
+            bound = frame_bound if key == "slot_frame" else 1e-12
             np.testing.assert_allclose(plain[key][i, :slots[i]], compiled[key][i, :slots[i]],
-                                       rtol=0, atol=1e-12, err_msg=f"{key}, case {i}")
+                                       rtol=0, atol=bound, err_msg=f"{key}, case {i}")
     # Frames, quaternions, rotation matrices and profiles of O(1) inputs: closed forms of a
     # few dozen operations (quat_log: one atan2), 1e-14 is ~50 ulp.
     for key in ("frames", "normalized", "matrices", "products", "logs", "from_matrices",
