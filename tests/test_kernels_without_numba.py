@@ -121,7 +121,8 @@ def _run_battery(tmp_path, interpreter: str, mode: str, env=None) -> dict[str, n
 
 
 def _compare_with_compiled(plain: dict[str, np.ndarray]) -> None:
-    compiled = compute(_cases(), frames, gaps, quaternion, time_profiles)
+    cases = _cases()
+    compiled = compute(cases, frames, gaps, quaternion, time_profiles)
     # Discrete outcomes (how many contacts, which slots are kept) are the same: no random case
     # sits within round-off of a decision threshold.
     for key in ("count", "slots", "kept"):
@@ -139,7 +140,7 @@ def _compare_with_compiled(plain: dict[str, np.ndarray]) -> None:
     # difference over the gap: 1e-8 m / |gap| (|gap| taken no smaller than 1e-4 m).
     count = compiled["count"].astype(int)
     slots = compiled["slots"].astype(int)
-    kinds = _cases()["kinds"]
+    kinds = cases["kinds"]
     ring_face = {gaps.CIRCLE, gaps.ARC}, {gaps.RECTANGLE, gaps.DISC}
     for i in range(count.size):
         pair = set(int(k) for k in kinds[i])
