@@ -1,4 +1,5 @@
-"""The compiled time loop (ref_solver/compiled) against the Python step, its oracle.
+"""The compiled time loop (ref_solver/compiled) against the Python loop (ref_solver/python_loop),
+its oracle.
 
 Both paths call the same kernels; they differ in the order of a few sums (numpy's BLAS
 products against numba's loops, Newton's dense kernel above the sparse driver's 100 rows) and

@@ -31,7 +31,7 @@ OWN_DRIVERS = {"reference", "siconos"}
 #: loop of the engine's own. Each in-process engine's run.py must call one of them (so that a
 #: renamed primitive fails here instead of passing unseen).
 STEP_CALLS = {"mj_step", "mj_step1", "mj_step2", "stepSimulation", "AdvanceTo", "SolveSteps",
-              "SolveDynamic", "step", "advance"}
+              "SolveDynamic", "step", "advance", "advance_python"}
 
 
 def _package_dir(module: str) -> Path:
@@ -99,9 +99,9 @@ def test_an_engine_is_a_stepping_engine_that_leaves_the_run_to_the_base(name):
     assert len(runners) == 1, f"{name}/run.py: one StepRunner, found {len(runners)}"
 
 
-@pytest.mark.parametrize("name", IN_PROCESS)
-def test_no_engine_run_module_holds_a_time_loop(name):
-    tree = _tree(_in_process()[name] / "run.py")
+def _assert_no_time_loop(name: str, path: Path) -> None:
+    """``path`` has no while loop, calls a step primitive, and none inside a loop."""
+    tree = _tree(path)
     assert not [n for n in ast.walk(tree) if isinstance(n, ast.While)], \
         f"{name}/run.py has a while loop"
     loops = [node for node in ast.walk(tree) if isinstance(node, ast.For | ast.AsyncFor)]
@@ -112,6 +112,18 @@ def test_no_engine_run_module_holds_a_time_loop(name):
     assert stepping, f"{name}/run.py calls none of {sorted(STEP_CALLS)}"
     looped = [f"{_call_name(c)} (line {c.lineno})" for c in stepping if id(c) in in_loops]
     assert not looped, f"{name}/run.py takes steps inside a loop: {looped}"
+
+
+@pytest.mark.parametrize("name", IN_PROCESS)
+def test_no_engine_run_module_holds_a_time_loop(name):
+    _assert_no_time_loop(name, _in_process()[name] / "run.py")
+
+
+def test_the_reference_run_module_leaves_both_its_loops_to_the_solver():
+    """The reference's driver hands the run to one call of a loop in ref_solver/ (compiled, or
+    its Python oracle); Siconos's loop runs in its worker process (adapters/siconos/worker),
+    outside the run module by construction."""
+    _assert_no_time_loop("reference", _package_dir(ENGINES["reference"]) / "run.py")
 
 
 @pytest.mark.parametrize("name", IN_PROCESS)

@@ -24,8 +24,7 @@ from clearbench.adapters.reference.run import (
     RunStatistics,
     body_sample,
     choose_step_loop,
-    run_compiled,
-    run_python,
+    run_steps,
 )
 from clearbench.adapters.reference.settings import (
     OPTIONS,
@@ -86,8 +85,8 @@ class ReferenceEngine(ModuleEngine):
         if not loop.compiled:
             warm_python_step(model)
         build_seconds = time.perf_counter() - start
-        run = run_compiled if loop.compiled else run_python
-        status, message, stepping, taken = run(stepper, state, steps, recorder, com, statistics)
+        status, message, stepping, taken = run_steps(loop, stepper, state, steps, recorder, com,
+                                                     statistics)
         metadata = {
             "theta": config.theta, "projection": config.projection,
             "solver": config.method, "tolerance": config.solver.tolerance,

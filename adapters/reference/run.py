@@ -1,11 +1,12 @@
-"""The step loops of a reference run: which one steps it, the compiled loop and the Python
-step, recording into the run's samples and statistics.
+"""Driving a reference run: which loop steps it, and its record turned into the run's
+samples and statistics. Both loops live in the solver (:mod:`clearbench.ref_solver.compiled`
+and its Python oracle :mod:`clearbench.ref_solver.python_loop`) and fill one record.
 
 ``step_loop`` (an option of the engine): ``auto`` (default) steps in the compiled loop
 (:mod:`clearbench.ref_solver.compiled`) when it supports every feature of the run, else in the
-Python step; ``python`` and ``compiled`` force one (``compiled`` on a run it does not support
+Python loop; ``python`` and ``compiled`` force one (``compiled`` on a run it does not support
 is an error naming the missing feature). The run's metadata says which ran
-(``step_loop``) and, for the Python step under ``auto``, the feature the compiled loop lacks
+(``step_loop``) and, for the Python loop under ``auto``, the feature the compiled loop lacks
 (``step_loop_fallback``).
 """
 
@@ -22,6 +23,7 @@ from clearbench.kernels.quaternion import quat_rotate_batch
 from clearbench.ref_solver.compiled.loop import NON_FINITE, StepRecord, advance
 from clearbench.ref_solver.compiled.support import unsupported_feature
 from clearbench.ref_solver.compiled.system_arrays import compile_system
+from clearbench.ref_solver.python_loop import PythonLoopTotals, advance_python
 from clearbench.ref_solver.system import State
 
 STEP_LOOPS = ("auto", "python", "compiled")
@@ -76,23 +78,30 @@ def _warm_up(stepper) -> None:
             zeros.copy(), zeros.copy(), 0, np.array([0]), record)
 
 
-def run_compiled(stepper, state, steps: int, recorder, com: np.ndarray, statistics
-                 ) -> tuple[RunStatus, str, float, int]:
-    """Step ``state`` (updated in place) ``steps`` times in the compiled loop, filling
+def run_steps(loop: StepLoop, stepper, state, steps: int, recorder, com: np.ndarray,
+              statistics) -> tuple[RunStatus, str, float, int]:
+    """Step ``state`` (updated in place) ``steps`` times in the loop ``loop`` chose (the
+    compiled :func:`~clearbench.ref_solver.compiled.loop.advance` or its Python oracle
+    :func:`~clearbench.ref_solver.python_loop.advance_python`, one contract), filling
     ``recorder`` (its step-0 sample stored) and ``statistics`` (:class:`RunStatistics`).
 
-    Returns (status, message, stepping seconds, steps taken), as the engine's Python loop
-    ends them: a kernel exception is a crash whose last sample is the failing step's start, a
-    non-finite state a divergence."""
-    system, settings = compile_system(stepper)
+    Returns (status, message, stepping seconds, steps taken): a kernel exception is a crash
+    whose last sample is the failing step's start, a non-finite state a divergence."""
     schedule = np.asarray(recorder.schedule, dtype=np.int64)
-    record = StepRecord.allocate(system.fixed.shape[0], recorder.contact_force.shape[1],
+    record = StepRecord.allocate(stepper.system.body_count, recorder.contact_force.shape[1],
                                  steps, len(schedule))
+    totals = PythonLoopTotals(solver_seconds=float("nan")) if loop.compiled \
+        else PythonLoopTotals()
     status, message = RunStatus.OK, ""
     tick = time.perf_counter()
     try:
-        code, t_end = advance(system, settings, _memory(stepper, copy=False), state.t,
-                              state.x, state.p, state.v, state.omega, steps, schedule, record)
+        if loop.compiled:
+            system, settings = compile_system(stepper)
+            code, t_end = advance(system, settings, _memory(stepper, copy=False), state.t,
+                                  state.x, state.p, state.v, state.omega, steps, schedule,
+                                  record)
+        else:
+            code, t_end = advance_python(stepper, state, steps, schedule, record, totals)
     except (ArithmeticError, ValueError, np.linalg.LinAlgError) as error:
         code, t_end = None, float(record.clock[0])
         k = int(record.progress[1]) + 1
@@ -111,63 +120,10 @@ def run_compiled(stepper, state, steps: int, recorder, com: np.ndarray, statisti
         record.orientations[1:count], com)
     recorder.count = count
     if code is None and not recorder.is_full:
-        recorder.store(state.t, state.x - quat_rotate_batch(state.p, com), state.p, state.v,
-                       state.omega)
+        recorder.store(*body_sample(state, com))
     if code == NON_FINITE:
         status, message = RunStatus.DIVERGED, f"non-finite state at step {taken}"
-    steps_done = np.arange(1, taken + 1)
-    converged = record.step_converged[:taken]
-    statistics.solver_seconds = float("nan")  # not timed inside the compiled loop
-    statistics.contact_sweeps = int(record.step_sweeps[:taken].sum())
-    statistics.roundoff_steps = int(np.sum(converged & (record.step_residual[:taken]
-                                                        > statistics.tolerance)))
-    statistics.unconverged = steps_done[~converged].tolist()
-    statistics.unconverged_projection = steps_done[
-        ~record.step_projection_converged[:taken]].tolist()
-    return status, message, stepping, taken
-
-
-def run_python(stepper, state, steps: int, recorder, com: np.ndarray, statistics
-               ) -> tuple[RunStatus, str, float, int]:
-    """Step ``state`` ``steps`` times with the Python step (:meth:`Stepper.step`), filling
-    ``recorder`` (its step-0 sample stored) and ``statistics`` (:class:`RunStatistics`).
-
-    Returns (status, message, stepping seconds, steps taken): a kernel exception is a crash
-    whose last sample is the failing step's start, a non-finite state a divergence."""
-    h = stepper.settings.time_step
-    pair_count = stepper.system.pair_count
-    status, message = RunStatus.OK, ""
-    stepping = 0.0
-    taken = 0
-    for k in range(1, steps + 1):
-        tick = time.perf_counter()
-        try:
-            result = stepper.step(state)
-        except (ArithmeticError, ValueError, np.linalg.LinAlgError) as error:
-            # A failure inside a kernel is an outcome of the run: the state the step
-            # started from is kept as the last sample, to reproduce it.
-            if not recorder.is_full:
-                recorder.store(*body_sample(state, com))
-            status = RunStatus.CRASHED
-            message = (f"{type(error).__name__} in step {k} (from t = {state.t:.9g}; the "
-                       f"last sample is that step's start): {error}")
-            break
-        finally:
-            stepping += time.perf_counter() - tick
-        state = result.state
-        taken = k
-        finite = np.isfinite(state.x).all() and np.isfinite(state.v).all() and \
-            np.isfinite(state.omega).all()
-        stats = result.statistics
-        recorder.accumulate(stats.solver_iterations, stats.solver_converged,
-                            stats.solver_residual)
-        statistics.add(k, stats)
-        if recorder.is_due(k) or (not finite and not recorder.is_full):
-            recorder.store(*body_sample(state, com), contacts=_contact_sample(
-                result, h, pair_count))
-        if not finite:
-            status, message = RunStatus.DIVERGED, f"non-finite state at step {k}"
-            break
+    statistics.add_record(record, taken, totals)
     return status, message, stepping, taken
 
 
@@ -177,19 +133,6 @@ def body_sample(state: State, com: np.ndarray) -> tuple:
     (nb, 3) [L] (body frame)."""
     return (state.t, state.x - quat_rotate_batch(state.p, com), state.p, state.v,
             state.omega)
-
-
-def _contact_sample(result, h: float, pair_count: int) -> tuple:
-    """Per pair, the normal force (np,) and the world force on body B (np, 3) [F], averaged
-    over the step of length ``h`` [T], and the count of active contacts of the step."""
-    pairs, slots = np.nonzero(result.contact_active)
-    impulse = result.contact_impulse[pairs, slots]          # (k, 3) in contact frames
-    world = np.einsum("kr,krj->kj", impulse, result.contact_frame[pairs, slots])
-    normal = np.bincount(pairs, impulse[:, 0], pair_count) / h
-    force = np.zeros((pair_count, 3))
-    for axis in range(3):
-        force[:, axis] = np.bincount(pairs, world[:, axis], pair_count) / h
-    return normal, force, result.statistics.active_contacts
 
 
 @dataclass
@@ -204,14 +147,16 @@ class RunStatistics:
     unconverged: list[int] = field(default_factory=list)
     unconverged_projection: list[int] = field(default_factory=list)
 
-    def add(self, step: int, stats) -> None:
-        """Count the statistics of step ``step`` (1-based)."""
-        self.solver_seconds += stats.solver_seconds
-        self.contact_sweeps += stats.contact_sweeps
-        self.split_steps += stats.substeps > 1
-        if stats.solver_converged and stats.solver_residual > self.tolerance:
-            self.roundoff_steps += 1
-        if not stats.solver_converged:
-            self.unconverged.append(step)
-        if not stats.projection_converged:
-            self.unconverged_projection.append(step)
+    def add_record(self, record: StepRecord, taken: int, totals: PythonLoopTotals) -> None:
+        """The statistics of the ``taken`` steps completed in ``record`` (solver seconds NaN
+        when the loop was compiled: not timed inside it)."""
+        steps_done = np.arange(1, taken + 1)
+        converged = record.step_converged[:taken]
+        self.solver_seconds = totals.solver_seconds
+        self.split_steps = totals.split_steps
+        self.contact_sweeps = int(record.step_sweeps[:taken].sum())
+        self.roundoff_steps = int(np.sum(converged & (record.step_residual[:taken]
+                                                      > self.tolerance)))
+        self.unconverged = steps_done[~converged].tolist()
+        self.unconverged_projection = steps_done[
+            ~record.step_projection_converged[:taken]].tolist()
