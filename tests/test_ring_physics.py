@@ -67,12 +67,29 @@ def ring_scene(name, centre, tilt=0.0, spin=0.0, table="slab", horizon=0.6):
     )
 
 
-def _engines():
+def _engines(failing: dict[str, str] | None = None):
+    """Every engine as a parameter (the reference in the default suite, the others slow), with
+    a strict xfail on each engine of ``failing`` (name: the measured failure and its cause)."""
     names = []
     for name in ENGINES:
-        marks = () if name == "reference" else (pytest.mark.slow,)
+        marks = [] if name == "reference" else [pytest.mark.slow]
+        if failing and name in failing:
+            marks.append(pytest.mark.xfail(strict=True, reason=failing[name]))
         names.append(pytest.param(name, marks=marks, id=name))
     return names
+
+
+#: The engines whose ring is a ring of spheres (or a fan) placed from the ring's own x axis
+#: (adapters/primitive_pieces.py, Exudyn's disc_segments): turning that axis moves the pieces
+#: and so the rocking. Measured by this test's command (``-m slow``), path difference over
+#: 0.3 s between the two frames.
+_PIECES_IN_THE_RING_FRAME = {
+    "mujoco": "the ring's spheres are placed from its own x axis: the paths differ by 1.4e-5 m",
+    "pybullet": "the ring's spheres are placed from its own x axis: the paths differ by "
+                "3.6e-4 m",
+    "exudyn": "the ring's pieces are placed from its own x axis: the paths differ by 5.0e-3 m",
+    "drake": "the ring's spheres are placed from its own x axis: the paths differ by 2.9e-4 m",
+}
 
 
 def run(engine_name, scene):
@@ -100,7 +117,7 @@ def _axis(quaternions) -> np.ndarray:
     return np.stack([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)], axis=1)
 
 
-@pytest.mark.parametrize("engine_name", _engines())
+@pytest.mark.parametrize("engine_name", _engines(_PIECES_IN_THE_RING_FRAME))
 def test_turning_the_ring_about_its_own_axis_changes_nothing(engine_name):
     # Tilted 0.3 rad and dropped 5 mm onto the table, well inside it: it lands on its lowest
     # point, rocks and settles. The same hoop with its shape frame turned by 0.7 rad must
@@ -151,11 +168,12 @@ def test_a_ring_tilted_across_the_tables_edge_tips_back(engine_name):
     assert _axis(orientation[-1:])[0, 2] >= math.cos(0.05)
 
 
-@pytest.mark.xfail(strict=True, reason="measured in the reference: the lying ring stays on the "
-                   "table but slides 0.066 m inward (to x = -0.0963 m) in 0.6 s, both frames; "
-                   "cause not yet analysed")
 @pytest.mark.parametrize("spin", [0.0, 0.5 * math.pi], ids=["frame-0", "frame-90deg"])
-@pytest.mark.parametrize("engine_name", _engines())
+@pytest.mark.parametrize("engine_name", _engines({"reference": (
+    "measured in the reference: the lying ring stays on the table but slides 0.066 m inward "
+    "(to x = -0.0963 m) in 0.6 s, both frames, with the edge contact along the common normal "
+    "too; cause not yet analysed (MuJoCo, PyBullet, Exudyn, Drake and Siconos keep it within "
+    "1 mm)")}))
 def test_a_ring_lying_over_the_tables_edge_stays(engine_name, spin):
     # Lying flat, centre 0.03 m inside the edge (the ring reaches 0.07 m beyond it): its weight
     # acts inside its support on the table, so it stays, whatever its own frame. Ends: centre

@@ -5,8 +5,10 @@ The gap of a ring point is its signed distance to the face's solid
 (:func:`~.face_solids.face_solid_distance`: the top face over the face, the edge beyond its
 bound, the corner): continuous everywhere, and outside the solid so is its gradient (the
 normal). A pair's contact offset d (taken by the caller) makes this the gap of the torus of
-radius d about the ring, whose normal then stays continuous while the penetration is below d;
-a bare ring entering the solid at a sharp edge takes the normal of the nearest face there.
+radius d about the ring, whose normal then stays continuous while the penetration is below d.
+A bare ring's minimum at a face's edge (on it to round-off, or just inside) is the ring against
+the edge line along their common normal (:mod:`.ring_edges`); deeper inside, a bare ring takes
+the normal of the nearest face.
 
 The candidates (slots, :data:`RING_FACE_SLOTS` = 8, all always kept):
 
@@ -30,9 +32,13 @@ import math
 
 from clearbench.kernels.gaps.codes import TWO_PI
 from clearbench.kernels.gaps.face_solids import face_solid_distance
+from clearbench.kernels.gaps.ring_edges import (
+    edge_continuation,
+    ring_point,
+    ring_solid_distance,
+)
 from clearbench.kernels.gaps.staging import stage_contact
 from clearbench.kernels.gaps.vectors import (
-    add,
     column_of,
     rotate,
     rotate_back,
@@ -64,17 +70,8 @@ _PHASE_AXIS_MIN = 0.5
 
 
 @njit(cache=True, inline="always")
-def _point(centre, e1, e2, radius, theta):
-    """Point of the ring's centre line at ``theta`` (the frame ``centre``, ``e1``, ``e2`` are
-    in)."""
-    return add(centre, add(scaled(e1, radius * math.cos(theta)),
-                           scaled(e2, radius * math.sin(theta))))
-
-
-@njit(cache=True, inline="always")
 def _distance(theta, centre, e1, e2, radius, kind, size_1, size_2, depth):
-    return face_solid_distance(kind, size_1, size_2, depth,
-                               _point(centre, e1, e2, radius, theta))[0]
+    return ring_solid_distance(theta, centre, e1, e2, radius, kind, size_1, size_2, depth)
 
 
 @njit(cache=True)
@@ -139,7 +136,7 @@ def _stage_ring_point(index, theta, centre, e1, e2, radius, kind, size_1, size_2
     """Stage the contact of the ring point at ``theta``: gap = its distance to the solid, the
     normal the distance's gradient, the point on A the solid's surface point nearest it (all
     mapped from the face frame to world)."""
-    point = _point(centre, e1, e2, radius, theta)
+    point = ring_point(centre, e1, e2, radius, theta)
     distance, gradient = face_solid_distance(kind, size_1, size_2, depth, point)
     on_face = sub(point, scaled(gradient, distance))
     stage_contact(stage, index, distance,
@@ -259,8 +256,19 @@ def ring_face(kind, size_1, size_2, depth, face_position, face_rotation, ring_po
     if found == 2 and found_value[1] < found_value[0]:
         found_angle = (found_angle[1], found_angle[0])
     fills = (phase + high_index * spacing, phase + higher_index * spacing)
+    low_limit, high_limit = (phase, phase + span) if is_arc else (-math.inf, math.inf)
     for m in range(MINIMA):
         theta = found_angle[m] if m < found else fills[m - found]
+        if m < found:
+            value = _distance(theta, centre, e1, e2, radius, kind, size_1, size_2, depth)
+            is_edge, gap, _, on_edge, normal = edge_continuation(
+                theta, value, centre, e1, e2, radius, kind, size_1, size_2, depth, spacing,
+                low_limit, high_limit)
+            if is_edge:
+                stage_contact(stage, SUPPORT_POINTS + m, gap,
+                              to_world(face_position, face_rotation, on_edge),
+                              rotate(face_rotation, normal))
+                continue
         _stage_ring_point(SUPPORT_POINTS + m, theta, centre, e1, e2, radius, kind, size_1,
                           size_2, depth, face_position, face_rotation, stage)
     return RING_FACE_SLOTS
