@@ -132,4 +132,4 @@ def standing(validation: dict | None) -> str:
         return ""
     return ("The C-60 model as its source gives it (the reference engine) has "
             + "; ".join(parts) + ": the section 'C-60 against the paper' gives the measured "
-            "cause of each difference and the documented variant that reproduces it.")
+            "cause of each difference and the documented variants nearest the paper.")
