@@ -35,7 +35,7 @@ def face_solid_parameters(kind, params):
 
 
 @njit(cache=True, inline="always")
-def _through_thickness(z, depth):
+def through_thickness(z, depth):
     """(q, side) of the thickness: q = signed distance to the nearer of the top (z = 0) and
     bottom (z = -depth) planes as a box coordinate (|z - centre| - half thickness), side = +1
     toward the top, -1 toward the bottom; depth 0: the top plane alone (q = z, side +1)."""
@@ -64,7 +64,7 @@ def face_solid_distance(kind, size_1, size_2, depth, local):
         The point in the face's frame [L].
     """
     x, y, z = local
-    q_z, side_z = _through_thickness(z, depth)
+    q_z, side_z = through_thickness(z, depth)
     if kind == PLANE:
         return z, (0.0, 0.0, 1.0)
     if kind == DISC:

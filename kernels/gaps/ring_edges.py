@@ -31,7 +31,7 @@ from __future__ import annotations
 import math
 
 from clearbench.kernels.gaps.codes import DISC, PLANE, TWO_PI
-from clearbench.kernels.gaps.face_solids import face_solid_distance
+from clearbench.kernels.gaps.face_solids import face_solid_distance, through_thickness
 from clearbench.kernels.gaps.rings import ring_angle, ring_axis_distance
 from clearbench.kernels.gaps.vectors import add, cross, dot, norm, scaled, sub
 from clearbench.kernels.jit import njit
@@ -97,11 +97,7 @@ def _nearest_edge_faces(kind, size_1, size_2, depth, point):
     the two largest box coordinates (their edge is the solid's edge nearest the point), and
     the point's distance to that edge's line [L]."""
     x, y, z = point
-    if depth > 0.0:
-        centred = z + 0.5 * depth
-        q_z, side_z = abs(centred) - 0.5 * depth, 1.0 if centred >= 0.0 else -1.0
-    else:
-        q_z, side_z = z, 1.0
+    q_z, side_z = through_thickness(z, depth)
     if kind == DISC:
         q_r = math.hypot(x, y) - size_1
         return _FACE_Z, side_z, _FACE_RIM, 1.0, math.hypot(q_r, q_z)
@@ -138,13 +134,13 @@ def edge_continuation(theta, value, centre, e1, e2, radius, kind, size_1, size_2
     (value ``value`` [L]) when it is an edge contact (module docstring).
 
     ``spacing`` [rad]: the minima search's sample spacing; ``low_limit``, ``high_limit``: an
-    arc's ends (+-inf for a circle). Returns (is_edge, gap [L], point on the ring, point on
-    the edge, unit normal out of the solid), face frame; ``is_edge`` False (the other values
+    arc's ends (+-inf for a circle). Returns (is_edge, gap [L], point on the edge, unit normal
+    out of the solid), face frame; ``is_edge`` False (the other values
     unset) where the minimum is not at an edge.
     """
     none = (0.0, 0.0, 0.0)
     if kind == PLANE:
-        return False, 0.0, none, none, none
+        return False, 0.0, none, none
     near = ring_point(centre, e1, e2, radius, theta)
     face_a, side_a, face_b, side_b, to_edge = _nearest_edge_faces(kind, size_1, size_2, depth,
                                                                   near)
@@ -154,9 +150,9 @@ def edge_continuation(theta, value, centre, e1, e2, radius, kind, size_1, size_2
         # Inside: the deepest point of an arc cut off the edge lies on the edge's bisector,
         # sqrt(2) times its depth from the edge.
         if value < -band or to_edge > math.sqrt(2.0) * -value + band:
-            return False, 0.0, none, none, none
+            return False, 0.0, none, none
     elif to_edge > value + band:
-        return False, 0.0, none, none, none
+        return False, 0.0, none, none
     edge_point, direction, outward = _edge_line(kind, size_1, size_2, depth, face_a, side_a,
                                                 face_b, side_b, near)
     offset = sub(centre, edge_point)
@@ -165,21 +161,21 @@ def edge_continuation(theta, value, centre, e1, e2, radius, kind, size_1, size_2
     if not low < angle < high:
         # The ring's nearest point to the line is not within a sample of the minimum: the
         # ring does not pass the edge there (a ring around a disc's rim in its plane).
-        return False, 0.0, none, none, none
+        return False, 0.0, none, none
     tangent = add(scaled(e1, -math.sin(angle)), scaled(e2, math.cos(angle)))
     normal = cross(tangent, direction)
     length = norm(normal)
     if not length > _PARALLEL:
-        return False, 0.0, none, none, none
+        return False, 0.0, none, none
     normal = scaled(normal, (1.0 if dot(normal, outward) >= 0.0 else -1.0) / length)
     distance, perpendicular = ring_axis_distance(angle, offset, e1, e2, radius, direction)
     if distance > band and abs(dot(perpendicular, normal)) < (1.0 - _PARALLEL) * distance:
         # Apart, the ring and the line are not joined along their common normal (the nearest
         # point is no interior critical point of the distance): not an edge contact.
-        return False, 0.0, none, none, none
+        return False, 0.0, none, none
     on_ring = ring_point(centre, e1, e2, radius, angle)
     along = dot(sub(on_ring, edge_point), direction)
     if not _within_edge(kind, size_1, size_2, depth, edge_point, direction, along):
-        return False, 0.0, none, none, none
+        return False, 0.0, none, none
     gap = dot(sub(on_ring, edge_point), normal)
-    return True, gap, on_ring, sub(on_ring, scaled(normal, gap)), normal
+    return True, gap, sub(on_ring, scaled(normal, gap)), normal

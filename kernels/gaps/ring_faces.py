@@ -255,14 +255,14 @@ def ring_face(kind, size_1, size_2, depth, face_position, face_rotation, ring_po
         found += 1
     if found == 2 and found_value[1] < found_value[0]:
         found_angle = (found_angle[1], found_angle[0])
+        found_value = (found_value[1], found_value[0])
     fills = (phase + high_index * spacing, phase + higher_index * spacing)
     low_limit, high_limit = (phase, phase + span) if is_arc else (-math.inf, math.inf)
     for m in range(MINIMA):
         theta = found_angle[m] if m < found else fills[m - found]
         if m < found:
-            value = _distance(theta, centre, e1, e2, radius, kind, size_1, size_2, depth)
-            is_edge, gap, _, on_edge, normal = edge_continuation(
-                theta, value, centre, e1, e2, radius, kind, size_1, size_2, depth, spacing,
+            is_edge, gap, on_edge, normal = edge_continuation(
+                theta, found_value[m], centre, e1, e2, radius, kind, size_1, size_2, depth, spacing,
                 low_limit, high_limit)
             if is_edge:
                 stage_contact(stage, SUPPORT_POINTS + m, gap,
