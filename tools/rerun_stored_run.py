@@ -14,7 +14,6 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
-import sqlite3
 import time
 from pathlib import Path
 
@@ -22,34 +21,29 @@ import numpy as np
 
 from clearbench.adapters import ENGINES
 from clearbench.adapters.base import RunSettings
-from clearbench.scenarios.serialization import scene_from_json
+from clearbench.harness.run.store import ResultsStore
 
 
-def rerun(store: Path, key: str) -> str:
+def rerun(store: ResultsStore, key: str) -> str:
     """One line: the run's scene, its stepping time now, and the largest position difference."""
-    with sqlite3.connect(store / "runs.sqlite") as db:
-        row = db.execute("select scene_name, scene_hash, engine, preset, time_step, horizon, "
-                         "record_every, options, trajectory from runs where key = ?",
-                         (key,)).fetchone()
-        if row is None:
-            raise SystemExit(f"no run with key {key!r} in {store}")
-        name, scene_hash, engine_name, preset, step, horizon, every, options, path = row
-        scene_json = db.execute("select scene_json from scenes where scene_hash = ?",
-                                (scene_hash,)).fetchone()[0]
-    if engine_name != "reference":
-        raise SystemExit(f"run {key} is of engine {engine_name!r}; only the reference is rerun")
-    stored = np.load(store / path, allow_pickle=False)["positions"]
-    engine = importlib.import_module(ENGINES["reference"]).create(preset)
+    row = store.get(key)
+    if row is None:
+        raise SystemExit(f"no run with key {key!r} in {store.directory}")
+    if row["engine"] != "reference":
+        raise SystemExit(f"run {key} is of engine {row['engine']!r}; only the reference is rerun")
+    stored = store.load_trajectory(key).positions
+    engine = importlib.import_module(ENGINES["reference"]).create(row["preset"])
     tick = time.perf_counter()
-    trajectory = engine.run(scene_from_json(scene_json),
-                            RunSettings(time_step=step, horizon=horizon, record_every=every,
-                                        options=json.loads(options)))
+    trajectory = engine.run(store.scene(row["scene_hash"]),
+                            RunSettings(time_step=row["time_step"], horizon=row["horizon"],
+                                        record_every=row["record_every"],
+                                        options=json.loads(row["options"] or "{}")))
     seconds = time.perf_counter() - tick
     n = min(len(stored), len(trajectory.positions))
     difference = float(np.max(np.abs(trajectory.positions[:n] - stored[:n])))
-    return (f"{key} {name}: {seconds:.0f} s, samples {len(trajectory.positions)} against "
-            f"{len(stored)}, largest position difference {difference:.3e}, unconverged steps "
-            f"{list(trajectory.unconverged_steps)}")
+    return (f"{key} {row['scene_name']}: {seconds:.0f} s, samples {len(trajectory.positions)} "
+            f"against {len(stored)}, largest position difference {difference:.3e}, unconverged "
+            f"steps {list(trajectory.unconverged_steps)}")
 
 
 def main() -> None:
@@ -57,8 +51,9 @@ def main() -> None:
     parser.add_argument("keys", nargs="+", metavar="KEY")
     parser.add_argument("--store", type=Path, default=Path("reports/store"))
     args = parser.parse_args()
+    store = ResultsStore(args.store)
     for key in args.keys:
-        print(rerun(args.store, key), flush=True)
+        print(rerun(store, key), flush=True)
 
 
 if __name__ == "__main__":

@@ -31,7 +31,7 @@ from __future__ import annotations
 import math
 
 from clearbench.kernels.gaps.codes import DISC, PLANE, TWO_PI
-from clearbench.kernels.gaps.face_solids import face_solid_distance, through_thickness
+from clearbench.kernels.gaps.face_solids import through_thickness
 from clearbench.kernels.gaps.rings import ring_angle, ring_axis_distance
 from clearbench.kernels.gaps.vectors import add, cross, dot, norm, scaled, sub
 from clearbench.kernels.jit import njit
@@ -62,13 +62,6 @@ def ring_point(centre, e1, e2, radius, theta):
     in)."""
     return add(centre, add(scaled(e1, radius * math.cos(theta)),
                            scaled(e2, radius * math.sin(theta))))
-
-
-@njit(cache=True, inline="always")
-def ring_solid_distance(theta, centre, e1, e2, radius, kind, size_1, size_2, depth):
-    """Signed distance [L] of the ring point at ``theta`` to the face's solid."""
-    return face_solid_distance(kind, size_1, size_2, depth,
-                               ring_point(centre, e1, e2, radius, theta))[0]
 
 
 @njit(cache=True)

@@ -32,11 +32,7 @@ import math
 
 from clearbench.kernels.gaps.codes import TWO_PI
 from clearbench.kernels.gaps.face_solids import face_solid_distance
-from clearbench.kernels.gaps.ring_edges import (
-    edge_continuation,
-    ring_point,
-    ring_solid_distance,
-)
+from clearbench.kernels.gaps.ring_edges import edge_continuation, ring_point
 from clearbench.kernels.gaps.staging import stage_contact
 from clearbench.kernels.gaps.vectors import (
     column_of,
@@ -71,7 +67,9 @@ _PHASE_AXIS_MIN = 0.5
 
 @njit(cache=True, inline="always")
 def _distance(theta, centre, e1, e2, radius, kind, size_1, size_2, depth):
-    return ring_solid_distance(theta, centre, e1, e2, radius, kind, size_1, size_2, depth)
+    """Signed distance [L] of the ring point at ``theta`` to the face's solid."""
+    return face_solid_distance(kind, size_1, size_2, depth,
+                               ring_point(centre, e1, e2, radius, theta))[0]
 
 
 @njit(cache=True)
