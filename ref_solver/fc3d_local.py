@@ -37,6 +37,9 @@ AC = 0
 FB = 1
 PROJECTION = 2
 LOCAL_KIND = {"ac": AC, "fb": FB, "projection": PROJECTION}
+#: ``want_jacobian`` flags as np.bool_ values: a literal True / False argument would compile
+#: the local functions once for each.
+_WITH, _WITHOUT = np.bool_(True), np.bool_(False)
 
 N_VEC = 10
 N_MAT = 8
@@ -297,7 +300,7 @@ def _newton(
     r_try = vec[_RTRY]
     u_try = vec[_UTRY]
     phi_try = vec[_PHITRY]
-    merit = _merit_and_jacobian(kind, Wl, ql, mu, rho_n, rho_t, r, u, phi, mat, vec, True)
+    merit = _merit_and_jacobian(kind, Wl, ql, mu, rho_n, rho_t, r, u, phi, mat, vec, _WITH)
     residual = local_residual(r, u, ql, mu)
     slow_steps = 0
     for _ in range(max_iterations):
@@ -313,7 +316,7 @@ def _newton(
             for i in range(3):
                 r_try[i] = r[i] + step * d[i]
             merit_try = _merit_and_jacobian(
-                kind, Wl, ql, mu, rho_n, rho_t, r_try, u_try, phi_try, mat, vec, False
+                kind, Wl, ql, mu, rho_n, rho_t, r_try, u_try, phi_try, mat, vec, _WITHOUT
             )
             if merit_try <= (1.0 - 2e-4 * step) * merit:
                 accepted = True
@@ -323,7 +326,7 @@ def _newton(
             break
         for i in range(3):
             r[i] = r_try[i]
-        merit = _merit_and_jacobian(kind, Wl, ql, mu, rho_n, rho_t, r, u, phi, mat, vec, True)
+        merit = _merit_and_jacobian(kind, Wl, ql, mu, rho_n, rho_t, r, u, phi, mat, vec, _WITH)
         previous = residual
         residual = local_residual(r, u, ql, mu)
         slow_steps = slow_steps + 1 if residual > 0.5 * previous else 0
@@ -403,7 +406,8 @@ def solve_local(
         return LOCAL_OK
     best_residual = _keep_best(r, residual, best, np.inf)
     if kind == FB:  # FB loses its fast convergence at degenerate contacts: AC from there
-        residual = _newton(AC, Wl, ql, mu, rho_n, rho_t, r, tolerance, max_iterations, vec, mat)
+        residual = _newton(np.int64(AC), Wl, ql, mu, rho_n, rho_t, r, tolerance, max_iterations,
+                           vec, mat)
         best_residual = _keep_best(r, residual, best, best_residual)
         if best_residual <= tolerance:
             for i in range(3):
@@ -440,7 +444,7 @@ def solve_local(
     if best_residual > tolerance:  # still stuck: the other local function, from the best point
         for i in range(3):
             r[i] = best[i]
-        other = AC if kind == FB else FB
+        other = np.int64(AC) if kind == FB else np.int64(FB)
         residual = _newton(other, Wl, ql, mu, rho_n, rho_t, r, tolerance, max_iterations, vec,
                            mat)
         best_residual = _keep_best(r, residual, best, best_residual)

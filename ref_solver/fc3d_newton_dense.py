@@ -163,7 +163,7 @@ def newton_dense_kernel(W, q, mu, n_bilateral, r, u, tolerance, use_max, max_ite
                 n_history, floor
         iteration += 1
         merit = alart_curnier_system(r, u, mu, n_bilateral, rho_n, rho_t, rho_b, phi, A, B,
-                                     True)
+                                     np.bool_(True))
         if least_norm:
             step_ok = least_norm_direction(W, n_bilateral, rho_b, A, B, phi, J, d)
         else:
@@ -176,7 +176,7 @@ def newton_dense_kernel(W, q, mu, n_bilateral, r, u, tolerance, use_max, max_ite
                     r_try[i] = r[i] + step * d[i]
                 matvec_plus(W, r_try, q, u_try)
                 merit_try = alart_curnier_system(r_try, u_try, mu, n_bilateral, rho_n, rho_t,
-                                                 rho_b, phi_try, A_try, B_try, False)
+                                                 rho_b, phi_try, A_try, B_try, np.bool_(False))
                 if merit_try <= (1.0 - 2.0 * ARMIJO * step) * merit:
                     step_ok = True
                     break
@@ -194,9 +194,11 @@ def newton_dense_kernel(W, q, mu, n_bilateral, r, u, tolerance, use_max, max_ite
                 operator = bilateral_operator_dense(W, n_bilateral)
                 have_csr = True
             rescue_history[:] = np.nan
+            # (scalars as np.int64: a literal argument would compile nsgs_kernel once more)
             nsgs_kernel(csr_indptr, csr_indices, csr_data, q, mu, n_bilateral, operator, r,
-                        u_try, _AC, tolerance, use_max, RESCUE_SWEEPS, local_tolerance,
-                        local_max_iterations, RESCUE_SWEEPS, rescue_history, 0, 0)
+                        u_try, np.int64(_AC), tolerance, use_max, np.int64(RESCUE_SWEEPS),
+                        local_tolerance, local_max_iterations, np.int64(RESCUE_SWEEPS),
+                        rescue_history, np.int64(0), np.int64(0))
             matvec_plus(W, r, q, u)
         _, residual_q, residual_max = residuals(r, u, q, mu, n_bilateral)
         residual = residual_max if use_max else residual_q

@@ -214,7 +214,7 @@ def applied_forces(t, x, rotation, v, omega, mass, gravity, fixed, kinds, body_a
             for i in range(3):
                 out[b, i] = mass[b] * gravity[i]
     element_forces(t, x, rotation, v, omega, kinds, body_a, body_b, parameters, angle_memory,
-                   False, out)
+                   np.bool_(False), out)
     for b in range(nb):
         if fixed[b]:
             out[b, :] = 0.0
@@ -244,7 +244,7 @@ def spring_jacobians(t, x, p, v, omega, fixed, kinds, body_a, body_b, parameters
     rotation = rotation_matrices(p)
     base = np.zeros((nb, 6))
     element_forces(t, x, rotation, v, omega, kinds, body_a, body_b, parameters, angle_memory,
-                   True, base)
+                   np.bool_(True), base)
     for b in range(nb):
         if fixed[b] or not involved[b]:
             continue
@@ -264,7 +264,7 @@ def spring_jacobians(t, x, p, v, omega, fixed, kinds, body_a, body_b, parameters
                     rs[b] = quat_to_matrix(quat_multiply(p[b], quat_exp(rv)))
                 target = plus if sign > 0 else minus
                 element_forces(t, xs, rs, v, omega, kinds, body_a, body_b, parameters,
-                               angle_memory, True, target)
+                               angle_memory, np.bool_(True), target)
             for r in range(nb):
                 for i in range(6):
                     stiffness[6 * r + i, column] = (plus[r, i] - minus[r, i]) / (2.0 * step)
@@ -276,7 +276,7 @@ def spring_jacobians(t, x, p, v, omega, fixed, kinds, body_a, body_b, parameters
                 ws[b, k - 3] += 1.0
             bumped = np.zeros((nb, 6))
             element_forces(t, x, rotation, vs, ws, kinds, body_a, body_b, parameters,
-                           angle_memory, True, bumped)
+                           angle_memory, np.bool_(True), bumped)
             for r in range(nb):
                 for i in range(6):
                     damping[6 * r + i, column] = bumped[r, i] - base[r, i]

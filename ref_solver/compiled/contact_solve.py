@@ -26,6 +26,11 @@ METHOD_CODES = {"nsgs": METHOD_NSGS, "newton": METHOD_NEWTON, "hybrid": METHOD_H
 NO_NEWTON_FIRST, REGULARISED_FIRST, LEAST_NORM_FIRST = 0, 1, 2
 #: Iteration cap of the hybrid chain's Newton attempts (as ``MoreauJeanStepper``).
 HYBRID_NEWTON_ITERATIONS = 200
+#: The solvers' stall test off (``stall_window``, ``stall_after``). Constants passed to a
+#: kernel are typed as literals, and numba compiles a kernel once per distinct literal
+#: argument: scalars reach the kernels as ``np.int64`` / ``np.bool_`` values, the types a call
+#: from Python has, so that each kernel is compiled once.
+NO_STALL = np.int64(0)
 
 
 @njit(cache=True)
@@ -38,8 +43,8 @@ def _nsgs(w, csr, q, mu, n_bilateral, operator, r0, max_sweeps, cfg, history):
     data, indices, indptr = csr
     code, sweeps, residual_q, residual_max, _, _ = nsgs_kernel(
         indptr, indices, data, q, mu, n_bilateral, operator, r, u, cfg.local_kind,
-        cfg.tolerance, cfg.use_max, max_sweeps, cfg.local_tolerance, cfg.local_max_iterations,
-        cfg.check_interval, history, 0, 0)
+        cfg.tolerance, cfg.use_max, np.int64(max_sweeps), cfg.local_tolerance,
+        cfg.local_max_iterations, cfg.check_interval, history, NO_STALL, NO_STALL)
     residual = residual_max if cfg.use_max else residual_q
     converged = code == 0
     if (code == 1 or code == 2) and cfg.roundoff_floor:
@@ -54,9 +59,9 @@ def _newton(w, q, mu, n_bilateral, r0, max_iterations, least_norm, cfg, history)
     r = r0.copy()
     u = np.empty(q.size)
     code, iterations, residual, _, _, _, _, _ = newton_dense_kernel(
-        w, q, mu, n_bilateral, r, u, cfg.tolerance, cfg.use_max, max_iterations,
-        cfg.roundoff_floor, 0, 0, cfg.local_tolerance, cfg.local_max_iterations, history,
-        least_norm)
+        w, q, mu, n_bilateral, r, u, cfg.tolerance, cfg.use_max, np.int64(max_iterations),
+        cfg.roundoff_floor, NO_STALL, NO_STALL, cfg.local_tolerance, cfg.local_max_iterations,
+        history, np.bool_(least_norm))
     return r, iterations, residual, code == CONVERGED or code == ROUNDOFF
 
 

@@ -129,7 +129,7 @@ def _advance(s, cfg, memory, t, x, p, v, omega, steps, schedule, history, rec):
     step); the samples of ``schedule`` (S,) (steps, 0 first) into ``rec`` (see
     :class:`StepRecord`). Returns (status code, t at the end)."""
     progress = rec[16]
-    sample = 1
+    sample = np.int64(1)  # np.int64: a literal 1 would compile the _store_* kernels twice
     iterations, residual, converged = 0, 0.0, True
     status = OK
     for k in range(1, steps + 1):
