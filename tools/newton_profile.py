@@ -65,6 +65,11 @@ def counting_kernel():
     return njit(namespace["counting_newton_dense_kernel"])
 
 
+def _fresh(args):
+    """The arguments with their arrays copied (a kernel call writes into some)."""
+    return [a.copy() if isinstance(a, np.ndarray) else a for a in args]
+
+
 def record_calls(scene_name: str, time_step: float | None, skip: int, steps: int) -> list:
     """[(arguments, status, iterations, impulses)] of every dense Newton call of ``steps``
     Python steps after ``skip``."""
@@ -72,7 +77,7 @@ def record_calls(scene_name: str, time_step: float | None, skip: int, steps: int
     original = newton_dense.newton_dense_kernel
 
     def recording(*args):
-        copies = [a.copy() if isinstance(a, np.ndarray) else a for a in args]
+        copies = _fresh(args)
         out = original(*args)
         calls.append((copies, int(out[0]), int(out[1]), args[4].copy()))
         return out
@@ -90,10 +95,6 @@ def record_calls(scene_name: str, time_step: float | None, skip: int, steps: int
     finally:
         newton_dense.newton_dense_kernel = original
     return calls
-
-
-def _fresh(args):
-    return [a.copy() if isinstance(a, np.ndarray) else a for a in args]
 
 
 def main() -> None:
