@@ -14,7 +14,6 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
-import time
 from pathlib import Path
 
 import numpy as np
@@ -25,7 +24,8 @@ from clearbench.harness.run.store import ResultsStore
 
 
 def rerun(store: ResultsStore, key: str) -> str:
-    """One line: the run's scene, its stepping time now, and the largest position difference."""
+    """One line: the run's scene, its build and stepping times now [s], and the largest position
+    difference."""
     row = store.get(key)
     if row is None:
         raise SystemExit(f"no run with key {key!r} in {store.directory}")
@@ -33,15 +33,14 @@ def rerun(store: ResultsStore, key: str) -> str:
         raise SystemExit(f"run {key} is of engine {row['engine']!r}; only the reference is rerun")
     stored = store.load_trajectory(key).positions
     engine = importlib.import_module(ENGINES["reference"]).create(row["preset"])
-    tick = time.perf_counter()
     trajectory = engine.run(store.scene(row["scene_hash"]),
                             RunSettings(time_step=row["time_step"], horizon=row["horizon"],
                                         record_every=row["record_every"],
                                         options=json.loads(row["options"] or "{}")))
-    seconds = time.perf_counter() - tick
     n = min(len(stored), len(trajectory.positions))
     difference = float(np.max(np.abs(trajectory.positions[:n] - stored[:n])))
-    return (f"{key} {row['scene_name']}: {seconds:.0f} s, samples {len(trajectory.positions)} "
+    return (f"{key} {row['scene_name']}: build {trajectory.build_seconds:.0f} s, stepping "
+            f"{trajectory.stepping_seconds:.1f} s, samples {len(trajectory.positions)} "
             f"against {len(stored)}, largest position difference {difference:.3e}, unconverged "
             f"steps {list(trajectory.unconverged_steps)}")
 
