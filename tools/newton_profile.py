@@ -40,34 +40,51 @@ from clearbench.scenarios.library import get_scene
 #: Status names of :func:`fc3d_newton_dense.newton_dense_kernel`'s codes.
 STATUS = ("converged", "iteration cap", "hopeless", "non-finite", "no descent",
           "round-off floor")
-#: (anchor in the kernel's source, text inserted after it): the counters of ``counts``
-#: (0 iterations, 1 halvings, 2 rescues) and ``accepted`` (successful line searches by halvings).
-_COUNTERS = (
+#: (anchor in the kernel's source, the anchor with a counter after it): the counters of
+#: ``counts`` (0 iterations, 1 halvings, 2 rescues) and ``accepted`` (successful line searches
+#: by halvings).
+_COUNTERS = tuple((anchor, anchor + added) for anchor, added in (
     ("        iteration += 1\n", "        counts[0] += 1\n"),
     ("                step *= 0.5\n", "                counts[1] += 1\n"),
     ("            rescues += 1\n", "            counts[2] += 1\n"),
     ("                    step_ok = True\n", "                    accepted[_] += 1\n"),
-)
+))
+
+
+def edited_kernel(replacements, parameters: str = ""):
+    """The Newton kernel compiled again from its own source with each (anchor, text) of
+    ``replacements`` replaced (each anchor must occur exactly once) and ``parameters`` (e.g.
+    ``"counts, accepted, "``) put before its arguments."""
+    source = inspect.getsource(newton_dense.newton_dense_kernel.py_func)
+    source = source.replace("@njit(cache=True)\n", "").replace(
+        "def newton_dense_kernel(", "def edited_newton_dense_kernel(" + parameters)
+    for anchor, text in replacements:
+        if source.count(anchor) != 1:
+            raise RuntimeError(f"the Newton kernel changed: {anchor.strip()!r} is not found once")
+        source = source.replace(anchor, text)
+    namespace = dict(vars(newton_dense))
+    exec(source, namespace)  # noqa: S102 - the package's own kernel source, edited
+    return njit(namespace["edited_newton_dense_kernel"])
 
 
 def counting_kernel():
     """The Newton kernel compiled again with counters: ``f(counts (3,), accepted
     (MAX_HALVINGS + 1,), *the kernel's arguments)``."""
-    source = inspect.getsource(newton_dense.newton_dense_kernel.py_func)
-    source = source.replace("@njit(cache=True)\n", "").replace(
-        "def newton_dense_kernel(", "def counting_newton_dense_kernel(counts, accepted, ")
-    for anchor, added in _COUNTERS:
-        if source.count(anchor) != 1:
-            raise RuntimeError(f"the Newton kernel changed: {anchor.strip()!r} is not found once")
-        source = source.replace(anchor, anchor + added)
-    namespace = dict(vars(newton_dense))
-    exec(source, namespace)  # noqa: S102 - the package's own kernel source, with counters
-    return njit(namespace["counting_newton_dense_kernel"])
+    return edited_kernel(_COUNTERS, "counts, accepted, ")
 
 
-def _fresh(args):
+def fresh(args):
     """The arguments with their arrays copied (a kernel call writes into some)."""
     return [a.copy() if isinstance(a, np.ndarray) else a for a in args]
+
+
+def add_recording_arguments(parser: argparse.ArgumentParser) -> None:
+    """SCENE, --dt, --skip, --steps: the arguments of :func:`record_calls`."""
+    parser.add_argument("scene")
+    parser.add_argument("--dt", type=float, default=None,
+                        help="time step [the scene's time unit]; default the scene's")
+    parser.add_argument("--skip", type=int, default=0, help="steps taken before recording")
+    parser.add_argument("--steps", type=int, default=300, help="steps recorded")
 
 
 def record_calls(scene_name: str, time_step: float | None, skip: int, steps: int) -> list:
@@ -77,7 +94,7 @@ def record_calls(scene_name: str, time_step: float | None, skip: int, steps: int
     original = newton_dense.newton_dense_kernel
 
     def recording(*args):
-        copies = _fresh(args)
+        copies = fresh(args)
         out = original(*args)
         calls.append((copies, int(out[0]), int(out[1]), args[4].copy()))
         return out
@@ -99,11 +116,7 @@ def record_calls(scene_name: str, time_step: float | None, skip: int, steps: int
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("scene")
-    parser.add_argument("--dt", type=float, default=None,
-                        help="time step [the scene's time unit]; default the scene's")
-    parser.add_argument("--skip", type=int, default=0, help="steps taken before recording")
-    parser.add_argument("--steps", type=int, default=300, help="steps recorded")
+    add_recording_arguments(parser)
     parser.add_argument("--long", type=int, default=50,
                         help="a call of at least this many iterations is in the heavy tail")
     args = parser.parse_args()
@@ -117,16 +130,16 @@ def main() -> None:
     rows = []
     for arguments, status, iterations, impulses in calls:
         counts = np.zeros(3)
-        fresh = _fresh(arguments)
-        out = kernel(counts, accepted, *fresh)
+        copies = fresh(arguments)
+        out = kernel(counts, accepted, *copies)
         if int(out[0]) != status or int(out[1]) != iterations or not np.array_equal(
-                fresh[4], impulses):
+                copies[4], impulses):
             raise RuntimeError("the counting kernel does not reproduce a recorded call")
         rows.append((status, iterations, counts[1], counts[2], arguments[0].shape[0]))
     table = np.array(rows, dtype=float)
     started = time.perf_counter()
     for arguments, *_ in calls:
-        newton_dense.newton_dense_kernel(*_fresh(arguments))
+        newton_dense.newton_dense_kernel(*fresh(arguments))
     seconds = time.perf_counter() - started
     total_iterations = table[:, 1].sum()
     step = "the scene's step" if args.dt is None else f"step {args.dt}"
