@@ -7,7 +7,9 @@ import math
 import numpy as np
 import pytest
 
+from clearbench.harness.measure.instrument import independent_gap
 from clearbench.scenarios import geometry as G
+from clearbench.scenarios.shapes import Arc, Bore, Circle, Cylinder
 
 from .test_geometry import (
     EPS,
@@ -19,6 +21,7 @@ from .test_geometry import (
     random_rotation,
     rotation,
 )
+from .test_kernel_against_instrument import TOLERANCE
 
 FACE_PAIRS = [(face, other) for face in (G.RECTANGLE, G.DISC)
               for other in (G.SPHERE, G.CYLINDER, G.CIRCLE, G.ARC)]
@@ -161,35 +164,65 @@ def test_tilted_rings_and_arcs_in_a_bore_match_dense_sampling():
 
 
 def test_bore_patch_and_length_bound_the_ring_contact():
-    # A concave patch covering angles 0.5 .. 1.5 rad about +z, |z| <= 0.5.
+    # A concave patch covering angles 0.5 .. 1.5 rad about +z, |z| <= 0.5, radius 1.1, and a
+    # ring of radius 1 moved 0.05 off the axis. Toward the patch's middle (angle 1): the gap is
+    # the clearance minus the eccentricity, 0.05. Away from it (angle 3): the ring is nearest
+    # the patch's solid just outside its angles, at the patch's edge line (radius 1.1, angle
+    # 1.5), which lies in the ring's plane outside it: the distance from that point E to the
+    # ring, |E - c| - 1 (c the ring's centre), smaller than the radial gap where the ring
+    # crosses the edge's half-plane. Past the patch's end by 0.1: the hypotenuse of 0.05 and
+    # 0.1. All closed forms, exact to round-off: HAND.
     patch = (G.BORE, params(1.1, 0.5, 0.5, 1.5), np.zeros(3), IDENTITY)
     toward = np.array([math.cos(1.0), math.sin(1.0), 0.0])
     away = np.array([math.cos(3.0), math.sin(3.0), 0.0])
-    assert contacts(G.CIRCLE, params(1.0), 0.05 * toward, IDENTITY, *patch)[0].shape == (1,)
-    assert contacts(G.CIRCLE, params(1.0), 0.05 * away, IDENTITY, *patch)[0].shape == (0,)
+    gap = contacts(G.CIRCLE, params(1.0), 0.05 * toward, IDENTITY, *patch)[0]
+    assert gap.shape == (1,) and abs(gap[0] - 0.05) < HAND
+    centre = 0.05 * away
+    edge = 1.1 * np.array([math.cos(1.5), math.sin(1.5), 0.0])
+    gap = contacts(G.CIRCLE, params(1.0), centre, IDENTITY, *patch)[0]
+    assert gap.shape == (1,) and abs(gap[0] - (np.linalg.norm(edge - centre) - 1.0)) < HAND
     beyond = 0.05 * toward + [0.0, 0.0, 0.6]
-    assert contacts(G.CIRCLE, params(1.0), beyond, IDENTITY, *patch)[0].shape == (0,)
+    gap = contacts(G.CIRCLE, params(1.0), beyond, IDENTITY, *patch)[0]
+    assert gap.shape == (1,) and abs(gap[0] - math.hypot(0.05, 0.1)) < HAND
 
 
 @pytest.mark.parametrize("partner", ["circle", "arc", "cylinder"])
-def test_a_bore_with_a_depth_ignores_partners_behind_its_solid(partner):
-    # A concave patch of radius 1.1 over 0.5 .. 1.5 rad with depth 0.5 (fifth parameter): a
-    # ring or journal of radius 1.0 moved toward the patch so that it is 0.4 outside the
-    # radius is in the solid (a contact at gap -0.4), 0.6 outside it has gone round behind
-    # the solid (none, as the C4 hollow of c60-trip at 19.62 ms); without a depth (0) both are
-    # contacts. The gap is exact (clearance 0.1 minus the eccentricity): HAND.
+def test_a_bore_with_a_depth_has_a_back(partner):
+    # A concave patch of radius 1.1 over 0.5 .. 1.5 rad, |z| <= 0.5, and a ring or journal of
+    # radius 1.0 moved toward the patch so that it is 0.4 or 0.6 outside the radius. Without a
+    # depth (0) the patch's solid is unbounded outward: the gap is minus that radial depth, or
+    # for a ring minus 0.5 where the patch's end faces are nearer (0.6), exactly (HAND); a
+    # journal's end rims keep the radial depth there (the radial motion that parts the two: a
+    # journal's bore does not read its ends). With a depth of
+    # 0.5 (fifth parameter) the solid has a back: 0.4 outside the radius is nearer the back
+    # than the front, and 0.6 is behind it, where the ring still crosses the solid's wall on
+    # either side. A ring's gap is then the signed distance of its deepest point to that
+    # solid: the independent instrument's within its resolution and TOLERANCE (as the pair
+    # property tests). A journal is seen through its end rims: in the wall, but not as deep as
+    # its end face's middle, which the instrument finds (-0.156 against -0.25 here; a stated
+    # limitation of kernels/gaps/bores.py).
     toward = np.array([math.cos(1.0), math.sin(1.0), 0.0])
     shape = {"circle": (G.CIRCLE, params(1.0)), "arc": (G.ARC, params(1.0, 0.0, 2.0)),
              "cylinder": (G.CYLINDER, params(1.0, 0.2))}[partner]
-    for depth, expected in ((0.5, (1, 0)), (0.0, (1, 1))):
-        patch = (G.BORE, params(1.1, 0.5, 0.5, 1.5, depth), np.zeros(3), IDENTITY)
-        counts = []
-        for penetration in (0.4, 0.6):
-            gap = contacts(*shape, (0.1 + penetration) * toward, IDENTITY, *patch)[0]
-            counts.append(min(gap.shape[0], 1))
-            if gap.shape[0]:
-                assert np.all(np.abs(gap + penetration) < HAND)
-        assert tuple(counts) == expected
+    ours = {"circle": Circle("a", radius=1.0),
+            "arc": Arc("a", radius=1.0, start_angle=0.0, end_angle=2.0),
+            "cylinder": Cylinder("a", radius=1.0, half_length=0.2)}[partner]
+    for penetration in (0.4, 0.6):
+        position = (0.1 + penetration) * toward
+        patch = (G.BORE, params(1.1, 0.5, 0.5, 1.5, 0.0), np.zeros(3), IDENTITY)
+        gap = contacts(*shape, position, IDENTITY, *patch)[0]
+        depth = penetration if partner == "cylinder" else min(penetration, 0.5)
+        assert gap.shape[0] >= 1 and np.all(np.abs(gap + depth) < HAND)
+        patch = (G.BORE, params(1.1, 0.5, 0.5, 1.5, 0.5), np.zeros(3), IDENTITY)
+        gap = contacts(*shape, position, IDENTITY, *patch)[0]
+        reading = independent_gap(
+            ours, (position, np.array([1.0, 0.0, 0.0, 0.0])),
+            Bore("b", radius=1.1, half_length=0.5, start_angle=0.5, end_angle=1.5, depth=0.5),
+            (np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0])))
+        assert gap.shape[0] >= 1 and float(np.min(gap)) < 0.0
+        if partner != "cylinder":
+            assert (reading.gap - reading.resolution - TOLERANCE <= float(np.min(gap))
+                    <= reading.gap + TOLERANCE)
 
 
 def test_bore_depth_is_packed_and_validated():

@@ -83,19 +83,14 @@ PAIRS = {
     ("circle", "bore"): EXACT, ("arc", "bore"): EXACT, ("cylinder", "bore"): SEPARATION,
 }
 ORDERED = [(pair, swapped) for pair in PAIRS for swapped in (False, True)]
-#: Pairs whose check fails today, kept running as expected failures so the suite says when
-#: they pass: a ring or arc in a bore, both orders. Shrunk example: a ring of radius 1 in the
-#: end plane of a bore of radius 1 (z = -half_length), 0.0625 off its axis: the kernel reads
-#: the radial depth -0.0625, the instrument 0 (the ring lies on the bore's end face, where the
-#: solid's signed distance is 0): the kernel does not bound a ring's depth by the bore's ends.
-FAILING_TODAY = {("circle", "bore"), ("arc", "bore")}
+#: The thorough (``-m slow``) check of a journal in a bore fails on some draws: the kernel's
+#: two candidates are the journal's end rims (and the bore's end rims), so a journal whose
+#: lateral surface crosses a partial bore's cut edge between its ends, or one just beyond the
+#: bore's end, is not seen there (docs/contact-geometry.md, "Limitations").
 
 
 def _param(item):
-    marks = (pytest.mark.xfail(reason="ring/arc at a bore's end: the kernel reads the "
-                               "radial depth where the end face is nearer", strict=False),) \
-        if item[0] in FAILING_TODAY else ()
-    return pytest.param(item, marks=marks, id=_id(item))
+    return pytest.param(item, id=_id(item))
 
 
 def _id(item) -> str:
@@ -299,10 +294,6 @@ def test_every_pair_of_the_kernel_is_checked():
     assert {(SHAPE_KIND_NAMES[a], SHAPE_KIND_NAMES[b]) for a, b in CANONICAL_PAIRS} == set(PAIRS)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "journal's end rim at a partial bore's edge line: the kernel reads 0.0163 for a separation "
-    "of 0.001 (instrument) and 0.0153 touching; it sees the rim only once it penetrates "
-    "(-1e-7 read exactly). Cause not analysed"))
 @pytest.mark.parametrize("offset", [1e-3, 0.0])
 def test_a_journal_rim_at_a_partial_bores_edge_is_seen(offset):
     """The example the property test drew (under some collections of test files): a journal
@@ -310,7 +301,12 @@ def test_a_journal_rim_at_a_partial_bores_edge_is_seen(offset):
     bore's arc 0..1 rad, tilted 0.125 rad about the arc's start line, moved ``offset`` away
     from it [L]. The journal's end-rim point on the tilt axis is the pair's closest point, on
     the arc's start edge: the separation is ``offset`` (the instrument reads it within its
-    resolution, 4e-7), and the kernel's smallest gap must be it within TOLERANCE."""
+    resolution, 4e-7), and the kernel's smallest gap must be it within TOLERANCE.
+
+    The rim's point farthest from the bore's axis is the one opposite, outside the bore's
+    angles: a kernel that takes that point and drops it outside the angles (as the kernel did
+    until the rim's nearest point to the bore's solid was searched) reads 0.0163 here, the
+    other end's figure."""
     tilt = 0.125
     journal = Cylinder("a", radius=0.5, half_length=1.0)
     bore = Bore("b", radius=0.5, half_length=1.0, start_angle=0.0, end_angle=1.0, depth=None)

@@ -131,17 +131,19 @@ def _compare_with_compiled(plain: dict[str, np.ndarray]) -> None:
     # thousand ulp. Plain Python runs the same operations in the same order; they differ only
     # where libm and LLVM's intrinsics, or numpy's and numba's LAPACK (the roots of the
     # ring-angle quartic, polished by Newton steps afterwards), round differently.
-    # One exception, the witness points of a ring or arc against a face's solid: their slots
-    # 6..7 are minima over the ring's angle found by Brent's search (kernels/gaps/ring_faces.py),
-    # where the gap is quadratic in the angle, so the minimum's position is fixed by the gap's
-    # round-off only to sqrt(eps) ~ 1.5e-8 of the radius (<= 0.3 m here): 1e-8 m for those
-    # points. Their gaps keep 1e-12 (the gap is flat there to second order); their frames, past
-    # a face's edge the direction from the edge to the point, turn by at most the point's
-    # difference over the gap: 1e-8 m / |gap| (|gap| taken no smaller than 1e-4 m).
+    # One exception, the witness points of a ring or arc against a face's solid or a bore's:
+    # their slots 6..7 (a bore's one slot, where its closed form does not apply) are minima over
+    # the ring's angle found by Brent's search (kernels/gaps/ring_faces.py) or golden-section
+    # search (kernels/gaps/bore_solids.py), where the gap is quadratic in the angle, so the
+    # minimum's position is fixed by the gap's round-off only to sqrt(eps) ~ 1.5e-8 of the
+    # radius (<= 0.3 m here): 1e-8 m for those points. Their gaps keep 1e-12 (the gap is flat
+    # there to second order); their frames, past a face's edge the direction from the edge to
+    # the point, turn by at most the point's difference over the gap: 1e-8 m / |gap| (|gap|
+    # taken no smaller than 1e-4 m).
     count = compiled["count"].astype(int)
     slots = compiled["slots"].astype(int)
     kinds = cases["kinds"]
-    ring_face = {gaps.CIRCLE, gaps.ARC}, {gaps.RECTANGLE, gaps.DISC}
+    ring_face = {gaps.CIRCLE, gaps.ARC}, {gaps.RECTANGLE, gaps.DISC, gaps.BORE}
     for i in range(count.size):
         pair = set(int(k) for k in kinds[i])
         minima = bool(pair & ring_face[0]) and bool(pair & ring_face[1])

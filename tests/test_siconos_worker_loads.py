@@ -145,11 +145,12 @@ def test_capabilities_of_c60_state_law_loads_and_bounded_pairs():
         assert "stiffness Jacobian" in capabilities[feature].detail
     for pair in ("pair:arc-bore", "pair:bore-cylinder", "pair:cylinder-rectangle"):
         assert capabilities[pair].support is Support.NATIVE
-    # A bore drops the candidates outside its angles or length (inactive slots); a face's solid
-    # (kernels/gaps/face_solids.py) keeps every slot, past its bound too.
-    for pair in ("pair:arc-bore", "pair:bore-cylinder"):
-        assert "inactive" in capabilities[pair].detail
-    assert "inactive" not in capabilities["pair:cylinder-rectangle"].detail
+    # A journal's bore drops its candidates without an axial overlap (inactive slots); a face's
+    # solid (kernels/gaps/face_solids.py) and a ring's bore (kernels/gaps/bore_solids.py) keep
+    # every slot, past their bounds too.
+    assert "inactive" in capabilities["pair:bore-cylinder"].detail
+    for pair in ("pair:arc-bore", "pair:cylinder-rectangle"):
+        assert "inactive" not in capabilities[pair].detail
 
 
 def test_unknown_features_are_unsupported(monkeypatch):
@@ -171,15 +172,15 @@ def test_unknown_features_are_unsupported(monkeypatch):
 
 def test_projection_refuses_pairs_that_drop_candidates():
     """The combined projection pulls active contacts to y = 0 as equalities: a dropped slot
-    (gap 1e12) would be pulled back, so bores are unsupported with it, by preset and by option;
-    the default preset keeps them."""
+    (gap 1e12) would be pulled back, so a journal's bore is unsupported with it, by preset and
+    by option; the default preset keeps it."""
     scene = get_scene("c60-on")
     capabilities = siconos_engine.create("projection").capabilities(scene)
-    assert capabilities["pair:arc-bore"].support is Support.UNSUPPORTED
-    assert "index set 2" in capabilities["pair:arc-bore"].detail
-    # Pairs that never drop a candidate stay supported with projection: a face's solid keeps
-    # every slot past its bound.
-    for pair in ("pair:circle-cylinder", "pair:cylinder-rectangle"):
+    assert capabilities["pair:bore-cylinder"].support is Support.UNSUPPORTED
+    assert "index set 2" in capabilities["pair:bore-cylinder"].detail
+    # Pairs that never drop a candidate stay supported with projection: a face's solid and a
+    # ring's bore keep every slot past their bounds.
+    for pair in ("pair:circle-cylinder", "pair:cylinder-rectangle", "pair:arc-bore"):
         assert capabilities[pair].support is Support.NATIVE
     trajectory = siconos_engine.create("projection").run(scene)
     assert trajectory.status is RunStatus.UNSUPPORTED and "CombinedProjection" in trajectory.message
@@ -187,7 +188,7 @@ def test_projection_refuses_pairs_that_drop_candidates():
     trajectory = siconos_engine.create("nsn-ac").run(
         scene, RunSettings(options={"projection": True}))
     assert trajectory.status is RunStatus.UNSUPPORTED
-    assert "pair:arc-bore" in trajectory.message
+    assert "pair:bore-cylinder" in trajectory.message
 
 
 def test_the_worker_takes_quaternions_and_time_profiles_from_the_kernels(worker):

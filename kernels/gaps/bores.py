@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+from clearbench.kernels.gaps.bore_solids import radial_exit_is_nearest, ring_bore_minimum
 from clearbench.kernels.gaps.codes import ARC, CIRCLE, CYLINDER, TWO_PI
 from clearbench.kernels.gaps.rings import (
     arc_angle_in_range,
@@ -18,9 +19,12 @@ from clearbench.kernels.gaps.vectors import (
     axpy,
     column_of,
     dot,
+    rotate,
+    rotate_back,
     scaled,
     sub,
     to_local,
+    to_world,
 )
 from clearbench.kernels.jit import njit
 
@@ -37,12 +41,19 @@ def _bore_angle_in_range(bore_position, bore_rotation, point, start_angle, span)
 @njit(cache=True)
 def _ring_in_bore(ring_position, ring_rotation, ring_radius, start_angle, span, is_arc,
                   bore_position, bore_rotation, bore_radius, bore_half_length, bore_start,
-                  bore_span, check_axial, index, stage):
-    """Ring (A) inside the bore (B): gap = bore radius - largest distance of a ring point from
-    the bore axis; the normal points from that ring point radially outward (from A into B).
-    The contact is staged at ``index`` in every case and kept only if its point on the bore
-    lies within the bore's angles (and, with ``check_axial``, within |z| <= half_length).
-    Returns 1 if kept, else 0 (a compacting caller then reuses the slot).
+                  bore_span, bore_depth, check_axial, index, stage):
+    """Ring (A) inside the bore (B), staged at ``index``: the ring point of smallest signed
+    distance to the bore's solid (:mod:`.bore_solids`), the normal from it into the solid
+    (from A into B). Without ``check_axial`` (a journal's end rim, inside the axial overlap by
+    construction) the bore's ends are not read.
+
+    The closed form first: gap = bore radius - largest distance of a ring point from the bore
+    axis, the normal radially outward from that point. It is that smallest signed distance when
+    the point lies within the bore's angles and ends and, beyond the surface, is no nearer
+    another boundary of the solid (a point inside the hole is no nearer any other boundary
+    than the bore's surface, and a ring point no farther from the axis is no deeper). Otherwise
+    (the ring passing the bore's edge, its end, or deep in the solid)
+    :func:`.bore_solids.ring_bore_minimum`. Returns 1 (the slot is always kept).
     """
     axis = column_of(bore_rotation, 2)
     e1 = column_of(ring_rotation, 0)
@@ -60,22 +71,33 @@ def _ring_in_bore(ring_position, ring_rotation, ring_radius, start_angle, span, 
     ring_point = add(ring_position, add(scaled(e1, ring_radius * c),
                                           scaled(e2, ring_radius * s)))
     gap = bore_radius - distance
-    stage_contact(stage, index, gap, ring_point, outward)
+    half_length = bore_half_length if check_axial else math.inf
     on_bore = axpy(gap, outward, ring_point)
-    if check_axial and abs(dot(sub(on_bore, bore_position), axis)) > bore_half_length:
-        return 0
-    if not _bore_angle_in_range(bore_position, bore_rotation, on_bore, bore_start, bore_span):
-        return 0
+    if (abs(dot(sub(on_bore, bore_position), axis)) <= half_length
+            and _bore_angle_in_range(bore_position, bore_rotation, on_bore, bore_start,
+                                     bore_span)
+            and radial_exit_is_nearest(gap, to_local(bore_position, bore_rotation, ring_point),
+                                       bore_radius, half_length, bore_start, bore_span,
+                                       bore_depth)):
+        stage_contact(stage, index, gap, ring_point, outward)
+        return 1
+    _, smallest, point, gradient = ring_bore_minimum(
+        to_local(bore_position, bore_rotation, ring_position), rotate_back(bore_rotation, e1),
+        rotate_back(bore_rotation, e2), ring_radius, start_angle, span, is_arc, bore_radius,
+        half_length, bore_start, bore_span, bore_depth)
+    stage_contact(stage, index, smallest, to_world(bore_position, bore_rotation, point),
+                  rotate(bore_rotation, scaled(gradient, -1.0)))
     return 1
 
 
 @njit(cache=True, inline="always")
 def _cylinder_end_in_bore(end, direction, centre, reach, journal_position, journal_rotation,
                           journal_radius, journal_half_length, bore_position, bore_rotation,
-                          bore_radius, bore_half_length, bore_start, bore_span, index, stage):
+                          bore_radius, bore_half_length, bore_start, bore_span, bore_depth, index,
+                          stage):
     """The candidate at the ``end`` (-1: the bore's -z side, +1: its +z side) of the axial
     overlap of a journal (A) and a bore (B), staged at ``index``; True if kept. An end inside
-    the bore is the journal's end rim (ring in the bore, dropped outside the bore's angles); an
+    the bore is the journal's end rim (a ring in the bore, :func:`_ring_in_bore`); an
     end where the journal runs beyond the bore is the bore's end rim against the journal's
     lateral surface (always kept)."""
     axis_b = column_of(bore_rotation, 2)
@@ -95,13 +117,13 @@ def _cylinder_end_in_bore(end, direction, centre, reach, journal_position, journ
                         journal_position)
     return _ring_in_bore(rim_position, journal_rotation, journal_radius, 0.0, TWO_PI, False,
                          bore_position, bore_rotation, bore_radius, bore_half_length,
-                         bore_start, bore_span, False, index, stage) == 1
+                         bore_start, bore_span, bore_depth, False, index, stage) == 1
 
 
 @njit(cache=True)
 def _cylinder_in_bore(journal_position, journal_rotation, journal_radius, journal_half_length,
                       bore_position, bore_rotation, bore_radius, bore_half_length, bore_start,
-                      bore_span, stage):
+                      bore_span, bore_depth, stage):
     """Journal cylinder (A) inside the bore (B): one candidate at each end of their axial
     overlap, where the radial gap of two nearly coaxial cylinders is smallest (it is concave
     along the axis), in slot 0 (the bore's -z side) and slot 1 (its +z side)
@@ -117,11 +139,11 @@ def _cylinder_in_bore(journal_position, journal_rotation, journal_radius, journa
     kept_0 = _cylinder_end_in_bore(-1.0, direction, centre, reach, journal_position,
                                    journal_rotation, journal_radius, journal_half_length,
                                    bore_position, bore_rotation, bore_radius, bore_half_length,
-                                   bore_start, bore_span, 0, stage)
+                                   bore_start, bore_span, bore_depth, 0, stage)
     kept_1 = _cylinder_end_in_bore(1.0, direction, centre, reach, journal_position,
                                    journal_rotation, journal_radius, journal_half_length,
                                    bore_position, bore_rotation, bore_radius, bore_half_length,
-                                   bore_start, bore_span, 1, stage)
+                                   bore_start, bore_span, bore_depth, 1, stage)
     return 2, kept_0, kept_1
 
 
@@ -130,23 +152,25 @@ def bore_slots(kind_a, params_a, position_a, rotation_a, params_b, position_b, r
                stage):
     """A circle, arc or journal (A) inside a bore (B): (slots, kept_0, kept_1), every slot
     staged (:func:`_ring_in_bore`, :func:`_cylinder_in_bore`); slots -1 for any other A. A
-    slot whose gap is below -depth (``params_b[4]`` > 0) is not kept: A is behind the bore's
-    solid, not in it."""
+    ring's slot is always kept (its gap is a signed distance to the bore's solid, never below
+    -depth / 2); a journal's slot whose gap is below -depth (``params_b[4]`` > 0) is not kept:
+    the journal is behind the bore's solid, not in it."""
     bore_span = params_b[3] - params_b[2]
     if kind_a == CIRCLE:
         kept = _ring_in_bore(position_a, rotation_a, params_a[0], 0.0, TWO_PI, False,
                              position_b, rotation_b, params_b[0], params_b[1], params_b[2],
-                             bore_span, True, 0, stage)
-        return 1, kept == 1 and within_depth(params_b[4], stage, 0), False
+                             bore_span, params_b[4], True, 0, stage)
+        return 1, kept == 1, False
     if kind_a == ARC:
         kept = _ring_in_bore(position_a, rotation_a, params_a[0], params_a[1],
                              params_a[2] - params_a[1], True, position_b, rotation_b,
-                             params_b[0], params_b[1], params_b[2], bore_span, True, 0, stage)
-        return 1, kept == 1 and within_depth(params_b[4], stage, 0), False
+                             params_b[0], params_b[1], params_b[2], bore_span, params_b[4], True,
+                             0, stage)
+        return 1, kept == 1, False
     if kind_a == CYLINDER:
         slots, kept_0, kept_1 = _cylinder_in_bore(
             position_a, rotation_a, params_a[0], params_a[1], position_b, rotation_b,
-            params_b[0], params_b[1], params_b[2], bore_span, stage)
+            params_b[0], params_b[1], params_b[2], bore_span, params_b[4], stage)
         return (slots, kept_0 and within_depth(params_b[4], stage, 0),
                 kept_1 and slots == 2 and within_depth(params_b[4], stage, 1))
     return -1, False, False

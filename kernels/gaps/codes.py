@@ -67,10 +67,10 @@ PAIR_SLOTS = {
     (ARC, BORE): 1,
     (CYLINDER, BORE): 2,
 }
-#: Kinds whose pairs can leave a slot empty (``pair_contact_slots``'s kept False): a bore's
-#: candidate outside its angles or length, or deeper than its depth. Every other pair fills
-#: every slot with a candidate (a face's solid has a gap everywhere).
-DROPPING_KINDS = (BORE,)
+#: Canonical pairs that can leave a slot empty (``pair_contact_slots``'s kept False): a journal
+#: with no axial overlap with its bore, or behind the bore's depth. Every other pair fills
+#: every slot with a candidate (a face's or a bore's solid has a gap everywhere).
+DROPPING_PAIRS = ((CYLINDER, BORE),)
 #: The canonical pairs, in the order of :data:`PAIR_SLOTS`.
 CANONICAL_PAIRS = tuple(PAIR_SLOTS)
 

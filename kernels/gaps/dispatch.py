@@ -261,7 +261,8 @@ def pair_contact_slots(kind_a, params_a, position_a, rotation_a, kind_b, params_
                        rotation_b, out_gap, out_point_a, out_point_b, out_frame, out_kept):
     """:func:`pair_contacts` with every candidate in a fixed slot, dropped or not.
 
-    A bore drops the candidates outside its angles or length, or deeper than its depth;
+    A journal's bore drops its candidates when they do not overlap axially or the journal is
+    deeper than the bore's depth;
     :func:`pair_contacts` compacts the kept ones to the front. Here slot k is always the same
     candidate of the kernel (an engine with one interaction per candidate follows it from step
     to step) and ``out_kept[k]`` says whether the bounds keep it; the kept slots, in order, are

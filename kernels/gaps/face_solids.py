@@ -46,6 +46,27 @@ def through_thickness(z, depth):
     return abs(centred) - half, 1.0 if centred >= 0.0 else -1.0
 
 
+@njit(cache=True, inline="always")
+def product_distance(first, first_gradient, second, second_gradient):
+    """Signed distance [L] to the product of two sets in orthogonal subspaces, and its unit
+    gradient, from each set's signed distance (``first``, ``second``) and unit gradient
+    (3-tuples, each in its own subspace): outside, the hypotenuse of the parts that are
+    outside; inside, the larger (less negative) of the two, ``first`` on ties."""
+    out_first = max(first, 0.0)
+    out_second = max(second, 0.0)
+    outside = math.hypot(out_first, out_second)
+    if outside > 0.0:
+        return outside, ((first_gradient[0] * out_first + second_gradient[0] * out_second)
+                         / outside,
+                         (first_gradient[1] * out_first + second_gradient[1] * out_second)
+                         / outside,
+                         (first_gradient[2] * out_first + second_gradient[2] * out_second)
+                         / outside)
+    if first >= second:
+        return first, first_gradient
+    return second, second_gradient
+
+
 @njit(cache=True)
 def face_solid_distance(kind, size_1, size_2, depth, local):
     """Signed distance [L] from the face-frame point ``local`` (3-tuple) to the face's solid
@@ -73,16 +94,7 @@ def face_solid_distance(kind, size_1, size_2, depth, local):
             u_x, u_y = x / radial, y / radial
         else:
             u_x, u_y = 1.0, 0.0
-        q_r = radial - size_1
-        out_r = max(q_r, 0.0)
-        out_z = max(q_z, 0.0)
-        outside = math.hypot(out_r, out_z)
-        if outside > 0.0:
-            return outside, (u_x * out_r / outside, u_y * out_r / outside,
-                             side_z * out_z / outside)
-        if q_z >= q_r:
-            return q_z, (0.0, 0.0, side_z)
-        return q_r, (u_x, u_y, 0.0)
+        return product_distance(q_z, (0.0, 0.0, side_z), radial - size_1, (u_x, u_y, 0.0))
     side_x = 1.0 if x >= 0.0 else -1.0
     side_y = 1.0 if y >= 0.0 else -1.0
     q_x = abs(x) - size_1

@@ -25,10 +25,10 @@ arc-cylinder        1   the same, restricted to the arc
 rectangle-X         as  plane-X for X = sphere (1), cylinder (8), circle (8), arc (8), each
 disc-X              ..  candidate's gap its distance to the face's solid (the edge beyond the
                         face's bound): never dropped
-circle-bore         1   ring point farthest from the bore axis; dropped outside the bore's
-arc-bore            1   angles or beyond its length
+circle-bore         1   ring point nearest the bore's solid (the farthest from its axis while
+arc-bore            1   that is within its angles and length): never dropped
 cylinder-bore       2   one per end of the axial overlap (slot 0 at the bore's -z side);
-                        dropped when there is no overlap or outside the bore's angles
+                        dropped when there is no overlap or behind the bore's depth
 =================  ===  =======================================================================
 
 Box-box and capsule-capsule are not supported: their candidates come from clipping or from a
@@ -56,13 +56,14 @@ CANONICAL_PAIRS = {
     (SHAPE_KINDS[kind_a], SHAPE_KINDS[kind_b]): slots
     for (kind_a, kind_b), slots in gaps.PAIR_SLOTS.items() if slots is not None
 }
-#: Gap [L] the worker hands Siconos for a dropped slot (a candidate outside a bore's angles or
+#: Gap [L] the worker hands Siconos for a dropped slot (a journal's candidate beyond its bore's
 #: length, or deeper than its depth): far beyond any activation threshold
 #: (y + h/2 y' <= ~1e-10 of the smallest feature), so the interaction stays inactive until the
 #: candidate comes back; finite, so Siconos's norms of the outputs stay finite.
 DROPPED_GAP = 1e12
-#: Shape kinds whose pairs can drop candidates (a bore): the kernels' DROPPING_KINDS.
-DROPPING_KINDS = tuple(SHAPE_KINDS[kind] for kind in gaps.DROPPING_KINDS)
+#: Canonical pairs that can drop candidates (a journal in a bore): the kernels' DROPPING_PAIRS.
+DROPPING_PAIRS = tuple((SHAPE_KINDS[kind_a], SHAPE_KINDS[kind_b])
+                       for kind_a, kind_b in gaps.DROPPING_PAIRS)
 
 #: Why the pairs of the shared geometry that the worker does not support are missing.
 NOT_PORTED = {
@@ -83,7 +84,7 @@ def candidate_count(kind_a, kind_b):
 
 def drops_candidates(kind_a, kind_b):
     """True if the pair (either order) can leave candidate slots empty."""
-    return kind_a in DROPPING_KINDS or kind_b in DROPPING_KINDS
+    return (kind_a, kind_b) in DROPPING_PAIRS or (kind_b, kind_a) in DROPPING_PAIRS
 
 
 def unsupported_reason(kind_a, kind_b):
