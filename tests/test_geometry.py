@@ -298,12 +298,20 @@ RING_FACE_PAIRS = {(face, ring) for face in (G.PLANE, G.RECTANGLE, G.DISC)
                    for ring in (G.CIRCLE, G.ARC)}
 
 
+RING_BORE_PAIRS = {(G.CIRCLE, G.BORE), (G.ARC, G.BORE), (G.CYLINDER, G.BORE)}
+
+
 def kinked_candidates(pair, gap) -> np.ndarray:
     """Candidates whose gap has no derivative: a ring's deepest point INSIDE a face's solid
-    (slots 6, 7 of kernels/gaps/ring_faces.py with a negative gap). Inside, the signed distance
-    is minus the distance to the nearest boundary face; along the ring its minimum typically
-    lies where two faces are equally near (the ring's deepest point in the corner region of an
-    edge), a corner of the function whose normal is that of one of the two faces."""
+    (slots 6, 7 of kernels/gaps/ring_faces.py with a negative gap) or inside a bore's solid (a
+    ring's one slot or a journal's end rims with a negative gap, kernels/gaps/bore_solids.py).
+    Inside, the signed distance is minus the distance to the nearest boundary face; along the
+    ring its minimum typically lies where two faces are equally near (the ring's deepest point
+    in the corner region of an edge, or level with a bore's end face), a corner of the function
+    whose normal is that of one of the two faces, or a flat stretch (the same depth below an
+    end face all along)."""
+    if pair in RING_BORE_PAIRS or pair[::-1] in RING_BORE_PAIRS:
+        return gap < 0.0
     if pair not in RING_FACE_PAIRS and pair[::-1] not in RING_FACE_PAIRS:
         return np.zeros(gap.shape[0], dtype=bool)
     return (np.arange(gap.shape[0]) >= 6) & (gap < 0.0)
@@ -326,7 +334,7 @@ def test_gap_derivative_is_the_normal(pair):
                            atol=1e-7)
         assert np.allclose(gap_derivative(a, b, "a", gap.shape[0])[smooth], -normal[smooth],
                            atol=1e-7)
-    assert checked > 0  # not vacuous (a bore drops the candidates beyond its bounds)
+    assert checked > 0  # not vacuous (a journal's bore drops candidates beyond its bounds)
 
 
 def test_box_box_corner_gaps_have_the_normal_as_derivative():
