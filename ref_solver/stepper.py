@@ -55,7 +55,9 @@ from clearbench.ref_solver.constraints import (
     delassus,
     row_values,
 )
-from clearbench.ref_solver.contact_problem import ContactProblem, SolverOptions
+from clearbench.ref_solver.contact_problem import ContactProblem, SolverOptions, SolverStatus
+from clearbench.ref_solver.fc3d_proximal import proximal_newton_dense
+from clearbench.ref_solver.fc3d_residual import residual_both
 from clearbench.ref_solver.fc3d_solve import solve_contact_problem
 from clearbench.ref_solver.forces import (
     no_angle_memory,
@@ -118,6 +120,11 @@ class StepperSettings:
     max_impact_splits : int
         Most impacts localised within one step (>= 1); later ones in the step are taken by the
         classic scheme.
+    proximal_rescue : float
+        > 0: when every attempt of the ``hybrid`` chain fails, a last one by proximal-point
+        Newton with the weight rho = ``proximal_rescue`` x the largest diagonal entry of W
+        (:mod:`.fc3d_proximal`), kept if it converges or ends below the best residual. 0 (the
+        default): no such attempt.
     """
 
     time_step: float
@@ -136,6 +143,7 @@ class StepperSettings:
     joint_law: str = "midpoint"
     localise_impacts: bool = False
     max_impact_splits: int = 1
+    proximal_rescue: float = 0.0
 
     def __post_init__(self) -> None:
         if not self.time_step > 0.0:
@@ -153,6 +161,8 @@ class StepperSettings:
                              "activation loop of the combined projection)")
         if not self.max_impact_splits >= 1:
             raise ValueError(f"max_impact_splits must be >= 1, got {self.max_impact_splits!r}")
+        if not self.proximal_rescue >= 0.0:
+            raise ValueError(f"proximal_rescue must be >= 0, got {self.proximal_rescue!r}")
 
 
 @dataclass(frozen=True)
@@ -558,7 +568,35 @@ class MoreauJeanStepper:
             if attempt.converged:
                 self._newton_first = options if options.method == "newton" else None
                 break
+        if not best.converged and cfg.proximal_rescue > 0.0:
+            best = self._proximal_rescue(problem, r0, best)
+            iterations += best.iterations
         return replace(best, iterations=iterations)
+
+    def _proximal_rescue(self, problem: ContactProblem, r0: np.ndarray | None, best):
+        """The hybrid chain's last attempt (:func:`fc3d_proximal.proximal_newton_dense`) from
+        the warm start: its result if it converged or ended below ``best``'s residual (its
+        ``iterations`` its own), else ``best`` with 0 iterations."""
+        solver = self.settings.solver
+        cap = self._solver_options[1].max_iterations  # the chain's Newton attempts' cap
+        W = problem.W.toarray() if hasattr(problem.W, "toarray") else np.asarray(problem.W)
+        start = np.zeros(problem.q.size) if r0 is None else r0
+        r, iterations, residual, converged = proximal_newton_dense(
+            W, problem.q, problem.mu, np.int64(problem.n_bilateral), start,
+            float(self.settings.proximal_rescue), float(solver.tolerance),
+            np.bool_(solver.use_max_normalisation), np.int64(cap),
+            np.bool_(solver.roundoff_floor), float(solver.local_tolerance),
+            np.int64(solver.local_max_iterations), np.empty(cap))
+        if not (converged or residual < best.residual):
+            return replace(best, iterations=0)
+        u = W @ r + problem.q
+        _, residual_q, residual_max = residual_both(r, u, problem.q, problem.mu,
+                                                    problem.n_bilateral)
+        return replace(best, r=r, u=u, iterations=int(iterations), residual=float(residual),
+                       residual_q=residual_q, residual_max=residual_max,
+                       converged=bool(converged),
+                       status=SolverStatus.CONVERGED if converged else best.status,
+                       method="proximal newton", message="")
 
     def _candidates(self, x, rotation):
         """(gap, point_a, point_b, frame, count) of every pair at (x, rotation)."""

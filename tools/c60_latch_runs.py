@@ -9,7 +9,8 @@ penetration over the recorded states [mm] (the gap kernel's); the steps whose co
 did not converge and those whose projection did not (count, and the first few).
 
     .venv/bin/python -m tools.c60_latch_runs --scene c60-trip --variant source \
-        --variant latch-face-normal --dt 1e-3 --dt 4e-3 [--clearance 0.07] [--horizon 4]
+        --variant latch-face-normal --dt 1e-3 --dt 4e-3 [--clearance 0.07] [--horizon 4] \
+        [--option proximal_rescue=1e-8]
 
 Only APIs that also exist in earlier revisions are used, so the same file run from another
 checkout's environment measures that checkout (``python /path/to/c60_latch_runs.py ...``).
@@ -34,15 +35,17 @@ JOINTS = tuple(f"J{i}" for i in range(1, 8))
 
 
 def run_line(scene_name: str, variant: str, time_step: float, clearance: float | None,
-             horizon: float | None, record_every: int) -> str:
-    """Run one configuration and return its line of figures."""
+             horizon: float | None, record_every: int, options: dict | None = None) -> str:
+    """Run one configuration (``options``: the reference engine's run options) and return its
+    line of figures."""
     parameters = {"variant": variant}
     if clearance is not None:
         parameters["clearances"] = {joint: clearance for joint in JOINTS}
     scene = get_scene(scene_name, **parameters)
     started = time.perf_counter()
     trajectory = create("default").run(scene, RunSettings(
-        time_step=time_step, horizon=horizon, record_every=record_every))
+        time_step=time_step, horizon=horizon, record_every=record_every,
+        options=options or {}))
     wall = time.perf_counter() - started
     hook = trajectory.orientations[:, trajectory.body_names.index("hook")]
     angle = 2.0 * np.degrees(np.arctan2(hook[:, 3], hook[:, 0]))
@@ -53,7 +56,8 @@ def run_line(scene_name: str, variant: str, time_step: float, clearance: float |
     unconverged = list(trajectory.unconverged_steps)
     count = int(getattr(trajectory, "unconverged_count", len(unconverged)))
     projections = list(metadata.get("unconverged_projections", []))
-    return (f"{scene_name} {variant} dt={time_step:g} clearance={clearance} "
+    shown = "".join(f" {key}={value}" for key, value in (options or {}).items())
+    return (f"{scene_name} {variant} dt={time_step:g} clearance={clearance}{shown} "
             f"status={trajectory.status.value} FC1={fc1:.4f} N hook={angle[-1] - angle[0]:+.3f} "
             f"deg strike={events.strike:.3f} release={events.release:.3f} "
             f"opening={events.opening:.3f} ms penetration={penetration:.3e} mm "
@@ -72,13 +76,20 @@ def main() -> None:
     parser.add_argument("--horizon", type=float, default=None, help="[ms] (default: scene's)")
     parser.add_argument("--record-every-ms", type=float, default=0.01,
                         help="recording interval [ms]")
+    parser.add_argument("--option", action="append", default=[], metavar="KEY=NUMBER",
+                        help="a numeric run option of the reference engine, e.g. "
+                             "proximal_rescue=1e-8")
     args = parser.parse_args()
+    options = {}
+    for item in args.option:
+        key, _, value = item.partition("=")
+        options[key] = float(value)
     for scene_name in args.scene:
         for variant in args.variant or ["source"]:
             for time_step in args.dt:
                 every = max(1, round(args.record_every_ms / time_step))
                 print(run_line(scene_name, variant, time_step, args.clearance, args.horizon,
-                               every), flush=True)
+                               every, options), flush=True)
 
 
 if __name__ == "__main__":

@@ -19,8 +19,10 @@ start), ``restitution_threshold`` (default 2 |g| h: slower impacts are plastic),
 with the projection has it on: an impact with e > 0 is applied at its crossing time within the
 step instead of over the whole step, which takes the bouncing-ball apex errors at h = 1e-3 s
 from 8e-3 to 2e-5),
-``roundoff_floor`` and ``step_loop`` (``auto``, ``python`` or ``compiled``:
-:mod:`.run`); see :class:`~clearbench.ref_solver.stepper.StepperSettings`.
+``roundoff_floor``, ``step_loop`` (``auto``, ``python`` or ``compiled``: :mod:`.run`) and
+``proximal_rescue`` (default 0: off; > 0, for instance 1e-8: a last attempt of the hybrid
+chain by proximal-point Newton when every other one failed, ref_solver/fc3d_proximal.py); see
+:class:`~clearbench.ref_solver.stepper.StepperSettings`.
 """
 
 from __future__ import annotations
@@ -59,6 +61,7 @@ OPTIONS = OptionTable("reference", (
     boolean("localise_impacts"),
     boolean("roundoff_floor"),
     choice("step_loop", ("auto", "python", "compiled")),
+    number("proximal_rescue", at_least=0.0),
 ))
 OPTION_NAMES = OPTIONS.names
 
@@ -97,6 +100,7 @@ def stepper_settings(preset: str, scene: Scene, settings: RunSettings) -> Steppe
         method=method,
         joint_law=str(options.get("joint_law", "midpoint")),
         localise_impacts=options["localise_impacts"],
+        proximal_rescue=float(options.get("proximal_rescue", 0.0)),
         # Bounces slower than two steps' worth of gravity cannot be resolved by the fixed
         # step; they are taken as plastic so that bodies come to rest (see StepperSettings).
         restitution_threshold=float(options.get(

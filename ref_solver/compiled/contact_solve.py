@@ -18,6 +18,7 @@ from clearbench.ref_solver.contact_problem import _dense_to_csr
 from clearbench.ref_solver.dense_kernels import bilateral_operator_dense, roundoff_floor_dense
 from clearbench.ref_solver.fc3d_newton_dense import CONVERGED, ROUNDOFF, newton_dense_kernel
 from clearbench.ref_solver.fc3d_nsgs import nsgs_kernel
+from clearbench.ref_solver.fc3d_proximal import proximal_newton_dense
 
 #: Method codes of :class:`.system_arrays.LoopSettings` (``StepperSettings.method``).
 METHOD_NSGS, METHOD_NEWTON, METHOD_HYBRID = 0, 1, 2
@@ -131,4 +132,12 @@ def solve(w, q, mu, n_bilateral, r0, cfg, newton_first, history):
             else:
                 newton_first[0] = NO_NEWTON_FIRST
             break
+    if not best_ok and cfg.proximal_rescue > 0.0:
+        r, its, res, ok = proximal_newton_dense(
+            w, q, mu, n_bilateral, r0, cfg.proximal_rescue, cfg.tolerance, cfg.use_max,
+            np.int64(HYBRID_NEWTON_ITERATIONS), cfg.roundoff_floor, cfg.local_tolerance,
+            cfg.local_max_iterations, history)
+        iterations += its
+        if ok or res < best_residual:
+            best_r, best_residual, best_ok = r, res, ok
     return best_r, iterations, best_residual, best_ok

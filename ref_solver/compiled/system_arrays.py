@@ -74,6 +74,7 @@ class LoopSettings(NamedTuple):
     local_max_iterations: int
     check_interval: int
     roundoff_floor: bool
+    proximal_rescue: float          # StepperSettings.proximal_rescue (0: off)
 
 
 def compile_system(stepper) -> tuple[CompiledSystem, LoopSettings]:
@@ -109,7 +110,8 @@ def compile_system(stepper) -> tuple[CompiledSystem, LoopSettings]:
         local_tolerance=float(solver.local_tolerance),
         local_max_iterations=int(solver.local_max_iterations),
         check_interval=int(solver.residual_check_interval),
-        roundoff_floor=bool(solver.roundoff_floor))
+        roundoff_floor=bool(solver.roundoff_floor),
+        proximal_rescue=float(cfg.proximal_rescue))
     return system, settings
 
 

@@ -1,0 +1,82 @@
+"""Proximal-point Newton on a dense one-step problem: the hybrid chain's last attempt when every
+other one failed (``StepperSettings.proximal_rescue``).
+
+The C-60's problems that the chain leaves unconverged have a rank-deficient Delassus operator
+(the redundant contacts of a bearing's two rings: rank 43-48 of 52-64 rows on ``c60-trip``,
+``tools/unconverged_steps.py``), where Newton's direction crawls and NSGS stops at a floor. The
+proximal-point iteration solves instead a sequence of problems whose operator W + rho I is
+positive definite,
+
+    r_{k+1} solves (W + rho I, q - rho r_k, mu),
+
+each by the semismooth Newton kernel started from r_k. Its velocity (W + rho I) r_{k+1} + q -
+rho r_k is W r_{k+1} + q + rho (r_{k+1} - r_k): a fixed point solves the original problem, and
+the iterate is judged on the original problem's residual (Rockafellar's proximal point
+algorithm; Carpentier et al. 2024, arXiv 2405.17020, use it for ill-conditioned Delassus
+operators of rigid contact). rho = ``relative_weight`` x the largest diagonal entry of W (a
+contact's own compliance), small enough that the fixed point is reached in a few outer
+iterations, large enough to lift the rank deficiency above round-off.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from clearbench.kernels.jit import njit
+from clearbench.ref_solver.dense_kernels import roundoff_floor_dense
+from clearbench.ref_solver.fc3d_newton_dense import newton_dense_kernel
+from clearbench.ref_solver.fc3d_residual import natural_map_squared, normalised
+
+#: Outer (proximal) iterations at most: on c60-trip's four unconverged problems at 1 us the
+#: fixed point is reached in 2-4 (rho = 1e-8 x the largest diagonal entry of W).
+PROXIMAL_OUTER_ITERATIONS = 10
+#: Each subproblem is solved to this fraction of the tolerance, so that its error does not
+#: hold the outer iteration above the tolerance.
+INNER_TOLERANCE_FACTOR = 1e-2
+#: The Newton kernel's stall test off (as ``compiled.contact_solve.NO_STALL``).
+_NO_STALL = np.int64(0)
+
+
+@njit(cache=True)
+def proximal_newton_dense(W, q, mu, n_bilateral, r0, relative_weight, tolerance, use_max,
+                          inner_iterations, use_floor, local_tolerance, local_max_iterations,
+                          history):
+    """Proximal-point Newton (module docstring) on (W (m, m), q (m,), mu (nc,), n_bilateral)
+    from ``r0`` (m,) (not modified). ``history`` (>= inner_iterations,): scratch.
+
+    Returns (r (m,), Newton iterations summed over the outer iterations, the original
+    problem's residual in the tested normalisation, converged): converged when that residual
+    is at most ``tolerance`` or, with ``use_floor``, its round-off floor.
+    """
+    m = q.size
+    scale = 0.0
+    for i in range(m):
+        scale = max(scale, W[i, i])
+    weight = relative_weight * scale
+    shifted_operator = W.copy()
+    for i in range(m):
+        shifted_operator[i, i] += weight
+    r = r0.copy()
+    u = np.empty(m)
+    shifted_q = np.empty(m)
+    iterations = 0
+    residual = np.inf
+    for _ in range(PROXIMAL_OUTER_ITERATIONS):
+        for i in range(m):
+            shifted_q[i] = q[i] - weight * r[i]
+        _, inner, _, _, _, _, _, _ = newton_dense_kernel(
+            shifted_operator, shifted_q, mu, n_bilateral, r, u,
+            tolerance * INNER_TOLERANCE_FACTOR, use_max, inner_iterations, use_floor,
+            _NO_STALL, _NO_STALL, local_tolerance, local_max_iterations, history,
+            np.bool_(False))
+        iterations += inner
+        u = W @ r + q
+        residual = normalised(math.sqrt(natural_map_squared(r, u, mu, n_bilateral)),
+                              math.sqrt(q.dot(q)), math.sqrt(r.dot(r)), math.sqrt(u.dot(u)),
+                              use_max)
+        if residual <= tolerance or (
+                use_floor and residual <= roundoff_floor_dense(W, r, u, q, mu, use_max)):
+            return r, iterations, residual, True
+    return r, iterations, residual, False
