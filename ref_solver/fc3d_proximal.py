@@ -20,14 +20,11 @@ iterations, large enough to lift the rank deficiency above round-off.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from clearbench.kernels.jit import njit
-from clearbench.ref_solver.dense_kernels import roundoff_floor_dense
+from clearbench.ref_solver.dense_kernels import residuals, roundoff_floor_dense
 from clearbench.ref_solver.fc3d_newton_dense import newton_dense_kernel
-from clearbench.ref_solver.fc3d_residual import natural_map_squared, normalised
 
 #: Outer (proximal) iterations at most: on c60-trip's four unconverged problems at 1 us the
 #: fixed point is reached in 2-4 (rho = 1e-8 x the largest diagonal entry of W).
@@ -46,9 +43,10 @@ def proximal_newton_dense(W, q, mu, n_bilateral, r0, relative_weight, tolerance,
     """Proximal-point Newton (module docstring) on (W (m, m), q (m,), mu (nc,), n_bilateral)
     from ``r0`` (m,) (not modified). ``history`` (>= inner_iterations,): scratch.
 
-    Returns (r (m,), Newton iterations summed over the outer iterations, the original
-    problem's residual in the tested normalisation, converged): converged when that residual
-    is at most ``tolerance`` or, with ``use_floor``, its round-off floor.
+    Returns (r (m,), u = W r + q (m,), Newton iterations summed over the outer iterations,
+    the original problem's residual |F| / |q|, the same / max(|q|, |r|, |u|), the one of the
+    two ``use_max`` tests, converged): converged when the tested residual is at most
+    ``tolerance`` or, with ``use_floor``, its round-off floor.
     """
     m = q.size
     scale = 0.0
@@ -62,7 +60,7 @@ def proximal_newton_dense(W, q, mu, n_bilateral, r0, relative_weight, tolerance,
     u = np.empty(m)
     shifted_q = np.empty(m)
     iterations = 0
-    residual = np.inf
+    residual_q = residual_max = residual = np.inf
     for _ in range(PROXIMAL_OUTER_ITERATIONS):
         for i in range(m):
             shifted_q[i] = q[i] - weight * r[i]
@@ -73,10 +71,9 @@ def proximal_newton_dense(W, q, mu, n_bilateral, r0, relative_weight, tolerance,
             np.bool_(False))
         iterations += inner
         u = W @ r + q
-        residual = normalised(math.sqrt(natural_map_squared(r, u, mu, n_bilateral)),
-                              math.sqrt(q.dot(q)), math.sqrt(r.dot(r)), math.sqrt(u.dot(u)),
-                              use_max)
+        _, residual_q, residual_max = residuals(r, u, q, mu, n_bilateral)
+        residual = residual_max if use_max else residual_q
         if residual <= tolerance or (
                 use_floor and residual <= roundoff_floor_dense(W, r, u, q, mu, use_max)):
-            return r, iterations, residual, True
-    return r, iterations, residual, False
+            return r, u, iterations, residual_q, residual_max, residual, True
+    return r, u, iterations, residual_q, residual_max, residual, False

@@ -57,7 +57,6 @@ from clearbench.ref_solver.constraints import (
 )
 from clearbench.ref_solver.contact_problem import ContactProblem, SolverOptions, SolverStatus
 from clearbench.ref_solver.fc3d_proximal import proximal_newton_dense
-from clearbench.ref_solver.fc3d_residual import residual_both
 from clearbench.ref_solver.fc3d_solve import solve_contact_problem
 from clearbench.ref_solver.forces import (
     no_angle_memory,
@@ -581,7 +580,7 @@ class MoreauJeanStepper:
         cap = self._solver_options[1].max_iterations  # the chain's Newton attempts' cap
         W = problem.W.toarray() if hasattr(problem.W, "toarray") else np.asarray(problem.W)
         start = np.zeros(problem.q.size) if r0 is None else r0
-        r, iterations, residual, converged = proximal_newton_dense(
+        r, u, iterations, residual_q, residual_max, residual, converged = proximal_newton_dense(
             W, problem.q, problem.mu, np.int64(problem.n_bilateral), start,
             float(self.settings.proximal_rescue), float(solver.tolerance),
             np.bool_(solver.use_max_normalisation), np.int64(cap),
@@ -589,9 +588,6 @@ class MoreauJeanStepper:
             np.int64(solver.local_max_iterations), np.empty(cap))
         if not (converged or residual < best.residual):
             return replace(best, iterations=0)
-        u = W @ r + problem.q
-        _, residual_q, residual_max = residual_both(r, u, problem.q, problem.mu,
-                                                    problem.n_bilateral)
         return replace(best, r=r, u=u, iterations=int(iterations), residual=float(residual),
                        residual_q=residual_q, residual_max=residual_max,
                        converged=bool(converged),

@@ -133,7 +133,7 @@ def solve(w, q, mu, n_bilateral, r0, cfg, newton_first, history):
                 newton_first[0] = NO_NEWTON_FIRST
             break
     if not best_ok and cfg.proximal_rescue > 0.0:
-        r, its, res, ok = proximal_newton_dense(
+        r, _, its, _, _, res, ok = proximal_newton_dense(
             w, q, mu, n_bilateral, r0, cfg.proximal_rescue, cfg.tolerance, cfg.use_max,
             np.int64(HYBRID_NEWTON_ITERATIONS), cfg.roundoff_floor, cfg.local_tolerance,
             cfg.local_max_iterations, history)
