@@ -26,6 +26,10 @@ from clearbench.kernels.jit import njit
 from clearbench.ref_solver.dense_kernels import residuals, roundoff_floor_dense
 from clearbench.ref_solver.fc3d_newton_dense import newton_dense_kernel
 
+#: The default relative weight (``StepperSettings.proximal_rescue``): on c60-trip's four
+#: unconverged problems at 1 us it reaches the fixed point in 2-4 outer iterations, to
+#: residuals of 2.5e-14 to 9.6e-13 (docs/reference-solver-speed.md, "A proximal-point rescue").
+DEFAULT_RELATIVE_WEIGHT = 1e-8
 #: Outer (proximal) iterations at most: on c60-trip's four unconverged problems at 1 us the
 #: fixed point is reached in 2-4 (rho = 1e-8 x the largest diagonal entry of W).
 PROXIMAL_OUTER_ITERATIONS = 10

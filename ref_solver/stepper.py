@@ -56,7 +56,7 @@ from clearbench.ref_solver.constraints import (
     row_values,
 )
 from clearbench.ref_solver.contact_problem import ContactProblem, SolverOptions, SolverStatus
-from clearbench.ref_solver.fc3d_proximal import proximal_newton_dense
+from clearbench.ref_solver.fc3d_proximal import DEFAULT_RELATIVE_WEIGHT, proximal_newton_dense
 from clearbench.ref_solver.fc3d_solve import solve_contact_problem
 from clearbench.ref_solver.forces import (
     no_angle_memory,
@@ -122,8 +122,9 @@ class StepperSettings:
     proximal_rescue : float
         > 0: when every attempt of the ``hybrid`` chain fails, a last one by proximal-point
         Newton with the weight rho = ``proximal_rescue`` x the largest diagonal entry of W
-        (:mod:`.fc3d_proximal`), kept if it converges or ends below the best residual. 0 (the
-        default): no such attempt.
+        (:mod:`.fc3d_proximal`), kept if it converges or ends below the best residual; default
+        :data:`.fc3d_proximal.DEFAULT_RELATIVE_WEIGHT` (1e-8). 0: no such attempt (the chain
+        before the rescue).
     """
 
     time_step: float
@@ -142,7 +143,7 @@ class StepperSettings:
     joint_law: str = "midpoint"
     localise_impacts: bool = False
     max_impact_splits: int = 1
-    proximal_rescue: float = 0.0
+    proximal_rescue: float = DEFAULT_RELATIVE_WEIGHT
 
     def __post_init__(self) -> None:
         if not self.time_step > 0.0:

@@ -84,8 +84,10 @@ def test_a_negative_weight_is_refused_naming_the_option():
             options={"proximal_rescue": -1.0}))
 
 
-def test_the_default_has_no_rescue():
+def test_the_default_rescues_with_the_measured_weight_and_zero_turns_it_off():
     scene = get_scene("pendulum")
     settings = create("default").run_settings(scene, RunSettings())
-    assert settings.proximal_rescue == 0.0
-    assert replace(settings, proximal_rescue=WEIGHT).proximal_rescue == WEIGHT
+    assert settings.proximal_rescue == WEIGHT
+    off = create("default").run_settings(scene, RunSettings(options={"proximal_rescue": 0}))
+    assert off.proximal_rescue == 0.0
+    assert replace(settings, proximal_rescue=0.0).proximal_rescue == 0.0

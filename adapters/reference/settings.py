@@ -20,8 +20,9 @@ with the projection has it on: an impact with e > 0 is applied at its crossing t
 step instead of over the whole step, which takes the bouncing-ball apex errors at h = 1e-3 s
 from 8e-3 to 2e-5),
 ``roundoff_floor``, ``step_loop`` (``auto``, ``python`` or ``compiled``: :mod:`.run`) and
-``proximal_rescue`` (default 0: off; > 0, for instance 1e-8: a last attempt of the hybrid
-chain by proximal-point Newton when every other one failed, ref_solver/fc3d_proximal.py); see
+``proximal_rescue`` (default 1e-8: a last attempt of the hybrid chain by proximal-point Newton
+when every other one failed, its weight relative to W's largest diagonal entry,
+ref_solver/fc3d_proximal.py; 0: off); see
 :class:`~clearbench.ref_solver.stepper.StepperSettings`.
 """
 
@@ -34,6 +35,7 @@ import numpy as np
 from clearbench.adapters.base import RunSettings
 from clearbench.adapters.options import OptionTable, boolean, choice, integer, number
 from clearbench.ref_solver.contact_problem import METHODS, SolverOptions
+from clearbench.ref_solver.fc3d_proximal import DEFAULT_RELATIVE_WEIGHT
 from clearbench.ref_solver.stepper import StepperSettings
 from clearbench.scenarios.scales import feature_lengths
 from clearbench.scenarios.scene import Scene
@@ -100,7 +102,7 @@ def stepper_settings(preset: str, scene: Scene, settings: RunSettings) -> Steppe
         method=method,
         joint_law=str(options.get("joint_law", "midpoint")),
         localise_impacts=options["localise_impacts"],
-        proximal_rescue=float(options.get("proximal_rescue", 0.0)),
+        proximal_rescue=float(options.get("proximal_rescue", DEFAULT_RELATIVE_WEIGHT)),
         # Bounces slower than two steps' worth of gravity cannot be resolved by the fixed
         # step; they are taken as plastic so that bodies come to rest (see StepperSettings).
         restitution_threshold=float(options.get(
