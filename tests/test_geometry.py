@@ -298,19 +298,20 @@ RING_FACE_PAIRS = {(face, ring) for face in (G.PLANE, G.RECTANGLE, G.DISC)
                    for ring in (G.CIRCLE, G.ARC)}
 
 
-RING_BORE_PAIRS = {(G.CIRCLE, G.BORE), (G.ARC, G.BORE), (G.CYLINDER, G.BORE)}
+RING_SOLID_PAIRS = {(G.CIRCLE, G.BORE), (G.ARC, G.BORE), (G.CYLINDER, G.BORE),
+                    (G.CIRCLE, G.CYLINDER), (G.ARC, G.CYLINDER)}
 
 
 def kinked_candidates(pair, gap) -> np.ndarray:
     """Candidates whose gap has no derivative: a ring's deepest point INSIDE a face's solid
-    (slots 6, 7 of kernels/gaps/ring_faces.py with a negative gap) or inside a bore's solid (a
-    ring's one slot or a journal's end rims with a negative gap, kernels/gaps/bore_solids.py).
-    Inside, the signed distance is minus the distance to the nearest boundary face; along the
-    ring its minimum typically lies where two faces are equally near (the ring's deepest point
-    in the corner region of an edge, or level with a bore's end face), a corner of the function
-    whose normal is that of one of the two faces, or a flat stretch (the same depth below an
-    end face all along)."""
-    if pair in RING_BORE_PAIRS or pair[::-1] in RING_BORE_PAIRS:
+    (slots 6, 7 of kernels/gaps/ring_faces.py with a negative gap) or inside a bore's or a
+    cylinder's solid (a ring's one slot or a journal's end rims with a negative gap,
+    kernels/gaps/round_solids.py). Inside, the signed distance is minus the distance to the
+    nearest boundary face; along the ring its minimum typically lies where two faces are equally
+    near (the ring's deepest point in the corner region of an edge, or level with an end face),
+    a corner of the function whose normal is that of one of the two faces, or a flat stretch
+    (the same depth below an end face all along)."""
+    if pair in RING_SOLID_PAIRS or pair[::-1] in RING_SOLID_PAIRS:
         return gap < 0.0
     if pair not in RING_FACE_PAIRS and pair[::-1] not in RING_FACE_PAIRS:
         return np.zeros(gap.shape[0], dtype=bool)
@@ -446,8 +447,10 @@ def test_tilted_ring_matches_dense_sampling(case):
             eccentricity = ring_radius + cylinder_radius + rng.uniform(-0.05, 0.1)
             scale = cylinder_radius
         ring_position = np.r_[eccentricity * in_plane, rng.uniform(-0.5, 0.5)]
+        # Half length 3: the ring (|z| <= 0.5 + 1) stays within the cylinder's length, where
+        # the distance to the axis minus the radius is the gap the sampling computes.
         gap, _, _, _ = contacts(G.CIRCLE, params(ring_radius), ring_position, ring_rotation,
-                                G.CYLINDER, params(cylinder_radius, 1.0), np.zeros(3),
+                                G.CYLINDER, params(cylinder_radius, 3.0), np.zeros(3),
                                 cylinder_rotation)
         reference = brute_force_ring_gap(ring_position, ring_rotation, ring_radius, np.zeros(3),
                                          cylinder_rotation, cylinder_radius)
@@ -455,6 +458,32 @@ def test_tilted_ring_matches_dense_sampling(case):
     # Both are minima of the same distance computed to round-off (~1e-16 of the radius 1);
     # 1e-9 relative to the clearance is the design target.
     assert worst < 1e-9, worst
+
+
+def test_a_ring_beyond_a_pins_end_is_outside_it():
+    # A ring (r 0.2) coaxial with a pin (r 0.5, half length 1), 0.3 past its end: every ring
+    # point is 0.3 from the pin's end face (the infinitely long pin would put it 0.3 inside).
+    pin = (G.CYLINDER, params(0.5, 1.0), np.zeros(3), IDENTITY)
+    ring = (G.CIRCLE, params(0.2), np.array([0.0, 0.0, 1.3]), IDENTITY)
+    for first, second in ((ring, pin), (pin, ring)):
+        gap = contacts(*first, *second)[0]
+        assert abs(gap[0] - 0.3) < 4 * EPS  # differences of O(1) numbers
+
+
+@pytest.mark.parametrize("kind", ["circle", "arc"])
+def test_a_ring_through_a_short_pin_leaves_it_through_the_end_face(kind):
+    # The example the property test drew: a ring (r 0.5) through the axis of a pin (r 0.5,
+    # half length 0.25) with parallel axes, in the pin's middle plane. Its point on the pin's
+    # axis is 0.5 from the lateral surface but 0.25 from either end face: depth 0.25.
+    pin = (G.CYLINDER, params(0.5, 0.25), np.array([0.5, 0.0, 0.0]), IDENTITY)
+    shape = params(0.5) if kind == "circle" else params(0.5, -1.0, 1.0)
+    ring = (G.CIRCLE if kind == "circle" else G.ARC, shape, np.zeros(3), IDENTITY)
+    gap, point_a, point_b, frame = contacts(*ring, *pin)
+    assert abs(gap[0] + 0.25) < 4 * EPS  # differences of O(1) numbers
+    # Every ring point within 0.25 of the pin's axis is that deep (a flat stretch of the
+    # depth): the witness is one of them, the normal along the axis (either end face).
+    assert np.linalg.norm(point_a[0] - [0.5, 0.0, 0.0]) <= 0.25 + 4 * EPS
+    assert np.allclose(np.abs(frame[0, 0]), [0.0, 0.0, 1.0], atol=4 * EPS)
 
 
 def test_tilted_arcs_match_dense_sampling_including_their_ends():
@@ -581,6 +610,50 @@ def test_box_on_its_edge_has_its_lowest_candidates_on_that_edge():
     gap = np.sort(contacts(*big, *small)[0])
     assert np.allclose(gap[:2], 1e-3, atol=32 * EPS)  # sines of 30 degrees on O(1) numbers
     assert gap[2] > 1e-3 + 0.1  # the other candidates are well above (0.2 by construction)
+
+
+@pytest.mark.parametrize("tilt", [0.6, 0.3])
+def test_separated_boxes_read_their_distance_past_the_reference_faces_bound(tilt):
+    # A plate (half 1 x 1 x 0.1) turned ``tilt`` rad about x, beside and above a cube's top
+    # edge (y = 1, z = 1), both 2 long in x: a problem of the (y, z) section, whose distance is
+    # the smallest of each section corner's distance to the other section (two convex
+    # polygons). The nearest points lie past the cube's top face, where face clipping reads only
+    # farther points (at 0.6 rad a height of 0.0804 for a distance of 0.0705; at 0.3 rad no
+    # candidate at all).
+    cube = (G.BOX, params(1.0, 1.0, 1.0), np.zeros(3), IDENTITY)
+    centre = np.array([1.95, 1.5])
+    plate = (G.BOX, params(1.0, 1.0, 0.1), np.array([0.0, *centre]), rotation((1, 0, 0), tilt))
+    along = np.array([math.cos(tilt), math.sin(tilt)])  # the plate's y axis in the section
+    across = np.array([-math.sin(tilt), math.cos(tilt)])  # its z axis
+    signs = [(-1, -1), (-1, 1), (1, -1), (1, 1)]
+    plate_corners = [centre + sy * along + 0.1 * sz * across for sy, sz in signs]
+    cube_corners = [np.array(corner, dtype=float) for corner in signs]
+    to_cube = min(np.linalg.norm(p - np.clip(p, -1.0, 1.0)) for p in plate_corners)
+    to_plate = min(np.linalg.norm(
+        (p - centre) @ np.column_stack([along, across])
+        - np.clip((p - centre) @ np.column_stack([along, across]), [-1.0, -0.1], [1.0, 0.1]))
+        for p in cube_corners)
+    distance = min(to_cube, to_plate)
+    for first, second in ((cube, plate), (plate, cube)):
+        gap, point_a, point_b, frame = contacts(*first, *second)
+        assert abs(gap.min() - distance) < 32 * EPS  # sines on O(1) numbers: a few ulp
+        nearest = np.argmin(gap)
+        cube_point = point_a[nearest] if first is cube else point_b[nearest]
+        # The cube's nearest point is its top edge (y = z = 1; the plate's corner clamps there).
+        assert np.allclose(cube_point[1:], 1.0, atol=32 * EPS)
+
+
+def test_boxes_side_by_side_diagonally_read_their_corners_distance():
+    # Unturned cubes offset along x, y and z: no point of either lies over a face of the other
+    # (face clipping keeps nothing); the nearest points are the facing corners.
+    offset = np.array([0.2, 0.1, 0.3])
+    a = (G.BOX, params(1.0, 1.0, 1.0), np.zeros(3), IDENTITY)
+    b = (G.BOX, params(1.0, 1.0, 1.0), 2.0 + offset, IDENTITY)
+    gap, point_a, point_b, frame = contacts(*a, *b)
+    assert gap.shape[0] == 1
+    assert abs(gap[0] - np.linalg.norm(offset)) < 4 * EPS  # sums of O(1) numbers
+    assert np.allclose(point_a[0], 1.0, atol=4 * EPS)
+    assert np.allclose(frame[0, 0], offset / np.linalg.norm(offset), atol=4 * EPS)
 
 
 # ------------------------------------------------------------------------------------------------

@@ -256,8 +256,14 @@ def test_journal_in_bore_contacts_at_the_ends_of_the_overlap(gap0):
     gap, point_a, point_b, _ = contacts(G.CYLINDER, params(1.0, 1.0), (e, 0.0, 0.8), IDENTITY,
                                         *bore)
     assert gap.shape == (2,) and np.allclose(np.sort(point_b[:, 2]), [-0.2, 1.0], atol=HAND)
-    # Entirely out: no candidate.
-    assert contacts(G.CYLINDER, params(1.0, 0.5), (e, 0.0, 2.0), IDENTITY, *bore)[0].shape == (0,)
+    # Entirely out, 0.5 beyond the bore's end: one candidate, its lower rim (radius 1 about
+    # x = e, at z = 1.5) against the bore's solid. Its point farthest from the axis, at radius
+    # 1.3 - gap0, is nearest the end rim (radius 1.3, z = 1) when over the hole (gap0 > 0), and
+    # over the end face, 0.5 above it, otherwise.
+    gap, point_a, _, frame = contacts(G.CYLINDER, params(1.0, 0.5), (e, 0.0, 2.0), IDENTITY,
+                                      *bore)
+    assert gap.shape == (1,) and abs(gap[0] - math.hypot(max(gap0, 0.0), 0.5)) < HAND
+    assert np.allclose(point_a[0], [1.3 - gap0, 0.0, 1.5], atol=HAND)
 
 
 def test_tilted_journal_touches_at_the_overlap_ends_as_dense_sampling_says():

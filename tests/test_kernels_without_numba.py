@@ -134,7 +134,7 @@ def _compare_with_compiled(plain: dict[str, np.ndarray]) -> None:
     # One exception, the witness points of a ring or arc against a face's solid or a bore's:
     # their slots 6..7 (a bore's one slot, where its closed form does not apply) are minima over
     # the ring's angle found by Brent's search (kernels/gaps/ring_faces.py) or golden-section
-    # search (kernels/gaps/bore_solids.py), where the gap is quadratic in the angle, so the
+    # search (kernels/gaps/round_solids.py), where the gap is quadratic in the angle, so the
     # minimum's position is fixed by the gap's round-off only to sqrt(eps) ~ 1.5e-8 of the
     # radius (<= 0.3 m here): 1e-8 m for those points. Their gaps keep 1e-12 (the gap is flat
     # there to second order); their frames, past a face's edge the direction from the edge to

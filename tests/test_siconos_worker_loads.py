@@ -146,7 +146,7 @@ def test_capabilities_of_c60_state_law_loads_and_bounded_pairs():
     for pair in ("pair:arc-bore", "pair:bore-cylinder", "pair:cylinder-rectangle"):
         assert capabilities[pair].support is Support.NATIVE
     # A journal's bore drops its candidates without an axial overlap (inactive slots); a face's
-    # solid (kernels/gaps/face_solids.py) and a ring's bore (kernels/gaps/bore_solids.py) keep
+    # solid (kernels/gaps/face_solids.py) and a ring's bore (kernels/gaps/round_solids.py) keep
     # every slot, past their bounds too.
     assert "inactive" in capabilities["pair:bore-cylinder"].detail
     for pair in ("pair:arc-bore", "pair:cylinder-rectangle"):

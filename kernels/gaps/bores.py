@@ -4,13 +4,17 @@ from __future__ import annotations
 
 import math
 
-from clearbench.kernels.gaps.bore_solids import radial_exit_is_nearest, ring_bore_minimum
 from clearbench.kernels.gaps.codes import ARC, CIRCLE, CYLINDER, TWO_PI
 from clearbench.kernels.gaps.rings import (
     arc_angle_in_range,
     ring_angle,
     ring_axis_distance,
     ring_cylinder,
+)
+from clearbench.kernels.gaps.round_solids import (
+    BORE_SOLID,
+    radial_exit_is_nearest,
+    ring_solid_minimum,
 )
 from clearbench.kernels.gaps.staging import copy_staged, stage_contact, within_depth
 from clearbench.kernels.gaps.vectors import (
@@ -43,7 +47,7 @@ def _ring_in_bore(ring_position, ring_rotation, ring_radius, start_angle, span, 
                   bore_position, bore_rotation, bore_radius, bore_half_length, bore_start,
                   bore_span, bore_depth, check_axial, index, stage):
     """Ring (A) inside the bore (B), staged at ``index``: the ring point of smallest signed
-    distance to the bore's solid (:mod:`.bore_solids`), the normal from it into the solid
+    distance to the bore's solid (:mod:`.round_solids`), the normal from it into the solid
     (from A into B). Without ``check_axial`` (a journal's end rim, inside the axial overlap by
     construction) the bore's ends are not read.
 
@@ -53,7 +57,7 @@ def _ring_in_bore(ring_position, ring_rotation, ring_radius, start_angle, span, 
     another boundary of the solid (a point inside the hole is no nearer any other boundary
     than the bore's surface, and a ring point no farther from the axis is no deeper). Otherwise
     (the ring passing the bore's edge, its end, or deep in the solid)
-    :func:`.bore_solids.ring_bore_minimum`. Returns 1 (the slot is always kept).
+    :func:`.round_solids.ring_solid_minimum`. Returns 1 (the slot is always kept).
     """
     axis = column_of(bore_rotation, 2)
     e1 = column_of(ring_rotation, 0)
@@ -81,10 +85,10 @@ def _ring_in_bore(ring_position, ring_rotation, ring_radius, start_angle, span, 
                                        bore_depth)):
         stage_contact(stage, index, gap, ring_point, outward)
         return 1
-    _, smallest, point, gradient = ring_bore_minimum(
-        to_local(bore_position, bore_rotation, ring_position), rotate_back(bore_rotation, e1),
-        rotate_back(bore_rotation, e2), ring_radius, start_angle, span, is_arc, bore_radius,
-        half_length, bore_start, bore_span, bore_depth)
+    _, smallest, point, gradient = ring_solid_minimum(
+        BORE_SOLID, to_local(bore_position, bore_rotation, ring_position),
+        rotate_back(bore_rotation, e1), rotate_back(bore_rotation, e2), ring_radius,
+        start_angle, span, is_arc, bore_radius, half_length, bore_start, bore_span, bore_depth)
     stage_contact(stage, index, smallest, to_world(bore_position, bore_rotation, point),
                   rotate(bore_rotation, scaled(gradient, -1.0)))
     return 1
@@ -127,15 +131,27 @@ def _cylinder_in_bore(journal_position, journal_rotation, journal_radius, journa
     """Journal cylinder (A) inside the bore (B): one candidate at each end of their axial
     overlap, where the radial gap of two nearly coaxial cylinders is smallest (it is concave
     along the axis), in slot 0 (the bore's -z side) and slot 1 (its +z side)
-    (:func:`_cylinder_end_in_bore`). Returns (slots, kept_0, kept_1): no overlap gives no slot
-    (nothing staged)."""
+    (:func:`_cylinder_end_in_bore`). Returns (2, kept_0, kept_1). Without axial overlap, slot
+    0 is the journal's end rim nearer the bore, a ring against the bore's solid with its ends
+    (:func:`_ring_in_bore`), so a journal pushed along its axis onto the bore's end face (or,
+    off centre, onto its rim) is seen before it enters the hole; slot 1 is dropped."""
     axis_b = column_of(bore_rotation, 2)
     axis_j = column_of(journal_rotation, 2)
     direction = 1.0 if dot(axis_j, axis_b) >= 0.0 else -1.0
     centre = dot(sub(journal_position, bore_position), axis_b)
     reach = journal_half_length * abs(dot(axis_j, axis_b))
     if centre - reach > bore_half_length or centre + reach < -bore_half_length:
-        return 0, False, False
+        # No axial overlap: the journal's end rim nearer the bore, a ring against the bore's
+        # solid (ends included), meets the bore's end face or its rim.
+        end = -1.0 if centre > 0.0 else 1.0
+        rim_position = axpy(direction * end * journal_half_length, axis_j, journal_position)
+        _ring_in_bore(rim_position, journal_rotation, journal_radius, 0.0, TWO_PI, False,
+                      bore_position, bore_rotation, bore_radius, bore_half_length, bore_start,
+                      bore_span, bore_depth, True, 0, stage)
+        # Slot 1 is dropped; it holds the journal's centre, a gap 0 and a normal across the
+        # bore's axis (an engine following slots from step to step reads a defined state).
+        stage_contact(stage, 1, 0.0, journal_position, any_perpendicular(axis_b))
+        return 2, True, False
     kept_0 = _cylinder_end_in_bore(-1.0, direction, centre, reach, journal_position,
                                    journal_rotation, journal_radius, journal_half_length,
                                    bore_position, bore_rotation, bore_radius, bore_half_length,

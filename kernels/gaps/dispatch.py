@@ -27,7 +27,7 @@ from clearbench.kernels.gaps.codes import (
 )
 from clearbench.kernels.gaps.faces import face_contacts
 from clearbench.kernels.gaps.planes import plane_box, plane_capsule, plane_cylinder, plane_sphere
-from clearbench.kernels.gaps.rings import ring_cylinder
+from clearbench.kernels.gaps.ring_cylinders import ring_cylinder_solid
 from clearbench.kernels.gaps.segments import capsule_capsule
 from clearbench.kernels.gaps.spheres import (
     box_sphere,
@@ -35,8 +35,7 @@ from clearbench.kernels.gaps.spheres import (
     cylinder_sphere,
     sphere_sphere,
 )
-from clearbench.kernels.gaps.staging import stage_contact
-from clearbench.kernels.gaps.vectors import any_perpendicular, axpy, column_of, cross, norm, scaled
+from clearbench.kernels.gaps.vectors import axpy, cross, norm, scaled
 from clearbench.kernels.jit import njit
 
 
@@ -87,12 +86,12 @@ def _canonical_contacts(kind_a, params_a, position_a, rotation_a, kind_b, params
         return compact_bore_slots(slots, kept_0, kept_1, stage)
     if kind_b == CYLINDER:
         if kind_a == CIRCLE:
-            return ring_cylinder(position_a, rotation_a, params_a[0], 0.0, TWO_PI, False,
-                                 position_b, rotation_b, params_b[0], stage)
+            return ring_cylinder_solid(position_a, rotation_a, params_a[0], 0.0, TWO_PI, False,
+                                       position_b, rotation_b, params_b[0], params_b[1], stage)
         if kind_a == ARC:
-            return ring_cylinder(position_a, rotation_a, params_a[0], params_a[1],
-                                 params_a[2] - params_a[1], True, position_b, rotation_b,
-                                 params_b[0], stage)
+            return ring_cylinder_solid(position_a, rotation_a, params_a[0], params_a[1],
+                                       params_a[2] - params_a[1], True, position_b,
+                                       rotation_b, params_b[0], params_b[1], stage)
     return -1
 
 
@@ -238,13 +237,6 @@ def _canonical_slots(kind_a, params_a, position_a, rotation_a, kind_b, params_b,
     if kind_b == BORE:
         slots, kept_0, kept_1 = bore_slots(kind_a, params_a, position_a, rotation_a, params_b,
                                            position_b, rotation_b, stage)
-        if slots == 0:
-            # A journal beside the bore (no axial overlap): two empty slots, each given the
-            # journal's centre, a gap 0 and a normal across the bore axis.
-            normal = any_perpendicular(column_of(rotation_b, 2))
-            for k in range(2):
-                stage_contact(stage, k, 0.0, position_a, normal)
-            slots = 2
         out_kept[0] = kept_0
         if slots == 2:
             out_kept[1] = kept_1
@@ -268,8 +260,9 @@ def pair_contact_slots(kind_a, params_a, position_a, rotation_a, kind_b, params_
     to step) and ``out_kept[k]`` says whether the bounds keep it; the kept slots, in order, are
     :func:`pair_contacts`'s output.
     A dropped slot holds the kernel's candidate before the bound applied; a journal with no
-    axial overlap with its bore fills its two slots with its centre, a gap 0 and a normal
-    across the bore axis. Pairs that drop nothing fill every slot with a kept candidate.
+    axial overlap with its bore fills its slot 1, dropped, with its centre, a gap 0 and a
+    normal across the bore axis (slot 0: its end rim nearer the bore, kept). Pairs that drop
+    nothing fill every slot with a kept candidate.
 
     Parameters
     ----------

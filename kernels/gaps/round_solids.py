@@ -1,4 +1,5 @@
-"""The solid around a bore, the signed distance of a point to it, and a ring's point nearest it.
+"""The solid around a bore and a cylinder's solid, the signed distance of a point to each, and a
+ring's point nearest either.
 
 A bore's solid, in the bore's own frame (axis z, angles from x toward y): the material outside
 the hole, radius <= rho <= radius + depth (depth 0: unbounded outward), within the bore's angles
@@ -6,10 +7,15 @@ the hole, radius <= rho <= radius + depth (depth 0: unbounded outward), within t
 an annular sector of the (x, y) plane and the interval |z| <= half_length, so its signed
 distance combines theirs as a disc face's solid does (:func:`.face_solids.product_distance`).
 
-:func:`ring_bore_minimum` finds the ring (or arc) point of smallest signed distance to that
+A cylinder's solid, in its frame (axis z): the disc rho <= radius times |z| <= half_length,
+a product in the same way.
+
+:func:`ring_solid_minimum` finds the ring (or arc) point of smallest signed distance to either
 solid. :mod:`.bores` uses it where its closed form (the ring point farthest from the axis)
 is not that point: the farthest point outside the bore's angles or beyond its ends, or deeper
-in the solid than the distance to a nearer boundary (an end face, a cut face, the back).
+in the solid than the distance to a nearer boundary (an end face, a cut face, the back);
+:mod:`.ring_cylinders` where the ring point nearest the cylinder's axis is not: past the
+cylinder's end, or deeper than the distance to an end face.
 """
 
 from __future__ import annotations
@@ -30,6 +36,8 @@ RING_SAMPLES = 64
 #: radius x 6e-14 at a kink and to round-off at a smooth minimum.
 GOLDEN_STEPS = 60
 _GOLDEN = 0.5 * (math.sqrt(5.0) - 1.0)
+#: The solids of :func:`ring_solid_minimum`.
+BORE_SOLID, CYLINDER_SOLID = 0, 1
 
 
 @njit(cache=True, inline="always")
@@ -112,6 +120,28 @@ def bore_solid_distance(radius, half_length, start_angle, span, depth, local):
                             (0.0, 0.0, 1.0 if z >= 0.0 else -1.0))
 
 
+@njit(cache=True)
+def cylinder_solid_distance(radius, half_length, local):
+    """Signed distance [L] from the cylinder-frame point ``local`` (3-tuple) to the cylinder's
+    solid (module docstring) and its unit gradient (cylinder frame), as
+    :func:`bore_solid_distance` (a point on the axis takes the frame's x as its radial
+    direction)."""
+    x, y, z = local
+    rho = math.hypot(x, y)
+    radial = (x / rho, y / rho, 0.0) if rho > 0.0 else (1.0, 0.0, 0.0)
+    return product_distance(rho - radius, radial, abs(z) - half_length,
+                            (0.0, 0.0, 1.0 if z >= 0.0 else -1.0))
+
+
+@njit(cache=True, inline="always")
+def _solid_distance(solid, radius, half_length, start_angle, span, depth, local):
+    """:func:`cylinder_solid_distance` for ``CYLINDER_SOLID`` (angles and depth unused), else
+    :func:`bore_solid_distance`."""
+    if solid == CYLINDER_SOLID:
+        return cylinder_solid_distance(radius, half_length, local)
+    return bore_solid_distance(radius, half_length, start_angle, span, depth, local)
+
+
 @njit(cache=True, inline="always")
 def _ring_local_point(centre, e1, e2, ring_radius, theta):
     c, s = math.cos(theta), math.sin(theta)
@@ -121,18 +151,19 @@ def _ring_local_point(centre, e1, e2, ring_radius, theta):
 
 
 @njit(cache=True)
-def _ring_distance(centre, e1, e2, ring_radius, theta, radius, half_length, start_angle, span,
-                   depth):
+def _ring_distance(solid, centre, e1, e2, ring_radius, theta, radius, half_length, start_angle,
+                   span, depth):
     point = _ring_local_point(centre, e1, e2, ring_radius, theta)
-    distance, _ = bore_solid_distance(radius, half_length, start_angle, span, depth, point)
+    distance, _ = _solid_distance(solid, radius, half_length, start_angle, span, depth, point)
     return distance
 
 
 @njit(cache=True)
-def ring_bore_minimum(centre, e1, e2, ring_radius, ring_start, ring_span, is_arc, radius,
-                      half_length, start_angle, span, depth):
-    """The ring (arc) point of smallest signed distance to the bore's solid, everything in the
-    bore's frame: (angle [rad], distance [L], point (3-tuple) [L], gradient (3-tuple)).
+def ring_solid_minimum(solid, centre, e1, e2, ring_radius, ring_start, ring_span, is_arc, radius,
+                       half_length, start_angle, span, depth):
+    """The ring (arc) point of smallest signed distance to the solid (``BORE_SOLID`` or
+    ``CYLINDER_SOLID``), everything in the solid's frame: (angle [rad], distance [L], point
+    (3-tuple) [L], gradient (3-tuple)).
 
     The distance is sampled at RING_SAMPLES angles over the ring (the arc, ends included) and
     minimised by golden-section search between the best sample's neighbours (GOLDEN_STEPS).
@@ -144,7 +175,8 @@ def ring_bore_minimum(centre, e1, e2, ring_radius, ring_start, ring_span, is_arc
     ring_radius, ring_start, ring_span : float
         The ring's radius [L]; an arc's first angle and span [rad] (``is_arc``).
     radius, half_length, start_angle, span, depth : float
-        The bore (:func:`bore_solid_distance`).
+        The bore (:func:`bore_solid_distance`); a cylinder's radius and half length (the
+        angles and depth unused).
     """
     first = ring_start if is_arc else 0.0
     extent = ring_span if is_arc else TWO_PI
@@ -153,7 +185,7 @@ def ring_bore_minimum(centre, e1, e2, ring_radius, ring_start, ring_span, is_arc
     best_k = 0
     best = math.inf
     for k in range(count):
-        value = _ring_distance(centre, e1, e2, ring_radius, first + k * spacing, radius,
+        value = _ring_distance(solid, centre, e1, e2, ring_radius, first + k * spacing, radius,
                                half_length, start_angle, span, depth)
         if value < best:
             best_k, best = k, value
@@ -164,28 +196,28 @@ def ring_bore_minimum(centre, e1, e2, ring_radius, ring_start, ring_span, is_arc
         high = min(high, first + extent)
     inner = high - _GOLDEN * (high - low)
     outer = low + _GOLDEN * (high - low)
-    f_inner = _ring_distance(centre, e1, e2, ring_radius, inner, radius, half_length,
+    f_inner = _ring_distance(solid, centre, e1, e2, ring_radius, inner, radius, half_length,
                              start_angle, span, depth)
-    f_outer = _ring_distance(centre, e1, e2, ring_radius, outer, radius, half_length,
+    f_outer = _ring_distance(solid, centre, e1, e2, ring_radius, outer, radius, half_length,
                              start_angle, span, depth)
     for _ in range(GOLDEN_STEPS):
         if f_inner <= f_outer:
             high, outer, f_outer = outer, inner, f_inner
             inner = high - _GOLDEN * (high - low)
-            f_inner = _ring_distance(centre, e1, e2, ring_radius, inner, radius, half_length,
+            f_inner = _ring_distance(solid, centre, e1, e2, ring_radius, inner, radius, half_length,
                                      start_angle, span, depth)
         else:
             low, inner, f_inner = inner, outer, f_outer
             outer = low + _GOLDEN * (high - low)
-            f_outer = _ring_distance(centre, e1, e2, ring_radius, outer, radius, half_length,
+            f_outer = _ring_distance(solid, centre, e1, e2, ring_radius, outer, radius, half_length,
                                      start_angle, span, depth)
     theta = first + best_k * spacing
     for candidate, value in ((inner, f_inner), (outer, f_outer)):
         if value < best:
             theta, best = candidate, value
     point = _ring_local_point(centre, e1, e2, ring_radius, theta)
-    distance, gradient = bore_solid_distance(radius, half_length, start_angle, span, depth,
-                                             point)
+    distance, gradient = _solid_distance(solid, radius, half_length, start_angle, span, depth,
+                                         point)
     return theta, distance, point, gradient
 
 
