@@ -10,7 +10,7 @@ did not converge and those whose projection did not (count, and the first few).
 
     .venv/bin/python -m tools.c60_latch_runs --scene c60-trip --variant source \
         --variant latch-face-normal --dt 1e-3 --dt 4e-3 [--clearance 0.07] [--horizon 4] \
-        [--option proximal_rescue=1e-8]
+        [--option proximal_rescue=0]
 
 Only APIs that also exist in earlier revisions are used, so the same file run from another
 checkout's environment measures that checkout (``python /path/to/c60_latch_runs.py ...``).
@@ -78,7 +78,7 @@ def main() -> None:
                         help="recording interval [ms]")
     parser.add_argument("--option", action="append", default=[], metavar="KEY=NUMBER",
                         help="a numeric run option of the reference engine, e.g. "
-                             "proximal_rescue=1e-8")
+                             "proximal_rescue=0 (the rescue off)")
     args = parser.parse_args()
     options = {}
     for item in args.option:
