@@ -22,6 +22,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from clearbench.kernels.gaps.codes import TWO_PI
 from clearbench.kernels.gaps.face_solids import product_distance, through_thickness
 from clearbench.kernels.gaps.rings import arc_angle_in_range
@@ -36,6 +38,10 @@ RING_SAMPLES = 64
 #: radius x 6e-14 at a kink and to round-off at a smooth minimum.
 GOLDEN_STEPS = 60
 _GOLDEN = 0.5 * (math.sqrt(5.0) - 1.0)
+#: Sampled local minima refined at most, the smallest sample's first: two basins can hold
+#: nearly equal minima (an arc across a partial bore's cut: 0.067346 and 0.067350 in basins
+#: 0.7 rad apart), which the smallest sample alone does not tell apart.
+REFINED_BASINS = 3
 #: The solids of :func:`ring_solid_minimum`.
 BORE_SOLID, CYLINDER_SOLID = 0, 1
 
@@ -158,6 +164,56 @@ def _ring_distance(solid, centre, e1, e2, ring_radius, theta, radius, half_lengt
     return distance
 
 
+@njit(cache=True, inline="always")
+def _is_sampled_minimum(values, k, is_arc):
+    """True if sample ``k`` is no larger than its neighbours (a ring's samples wrap around; an
+    arc's end has one neighbour)."""
+    count = values.size
+    if is_arc:
+        left = values[k - 1] if k > 0 else np.inf
+        right = values[k + 1] if k < count - 1 else np.inf
+    else:
+        left = values[(k - 1) % count]
+        right = values[(k + 1) % count]
+    return values[k] <= left and values[k] <= right
+
+
+@njit(cache=True)
+def _golden_section(solid, centre, e1, e2, ring_radius, first, extent, is_arc, spacing, k,
+                    sampled, radius, half_length, start_angle, span, depth):
+    """(angle [rad], distance [L]): the smallest of sample ``k`` (value ``sampled``) and the
+    golden-section search's last two points between its neighbours (an arc's bracket clipped to
+    the arc)."""
+    low = first + (k - 1) * spacing
+    high = first + (k + 1) * spacing
+    if is_arc:
+        low = max(low, first)
+        high = min(high, first + extent)
+    inner = high - _GOLDEN * (high - low)
+    outer = low + _GOLDEN * (high - low)
+    f_inner = _ring_distance(solid, centre, e1, e2, ring_radius, inner, radius, half_length,
+                             start_angle, span, depth)
+    f_outer = _ring_distance(solid, centre, e1, e2, ring_radius, outer, radius, half_length,
+                             start_angle, span, depth)
+    for _ in range(GOLDEN_STEPS):
+        if f_inner <= f_outer:
+            high, outer, f_outer = outer, inner, f_inner
+            inner = high - _GOLDEN * (high - low)
+            f_inner = _ring_distance(solid, centre, e1, e2, ring_radius, inner, radius,
+                                     half_length, start_angle, span, depth)
+        else:
+            low, inner, f_inner = inner, outer, f_outer
+            outer = low + _GOLDEN * (high - low)
+            f_outer = _ring_distance(solid, centre, e1, e2, ring_radius, outer, radius,
+                                     half_length, start_angle, span, depth)
+    theta = first + k * spacing
+    best = sampled
+    for candidate, value in ((inner, f_inner), (outer, f_outer)):
+        if value < best:
+            theta, best = candidate, value
+    return theta, best
+
+
 @njit(cache=True)
 def ring_solid_minimum(solid, centre, e1, e2, ring_radius, ring_start, ring_span, is_arc, radius,
                        half_length, start_angle, span, depth):
@@ -166,7 +222,8 @@ def ring_solid_minimum(solid, centre, e1, e2, ring_radius, ring_start, ring_span
     (3-tuple) [L], gradient (3-tuple)).
 
     The distance is sampled at RING_SAMPLES angles over the ring (the arc, ends included) and
-    minimised by golden-section search between the best sample's neighbours (GOLDEN_STEPS).
+    minimised by golden-section search (GOLDEN_STEPS) between the neighbours of the best sample
+    and of the next REFINED_BASINS - 1 sampled local minima; the smallest result is kept.
 
     Parameters
     ----------
@@ -182,39 +239,34 @@ def ring_solid_minimum(solid, centre, e1, e2, ring_radius, ring_start, ring_span
     extent = ring_span if is_arc else TWO_PI
     count = RING_SAMPLES if not is_arc else max(2, int(RING_SAMPLES * extent / TWO_PI) + 1)
     spacing = extent / count if not is_arc else extent / (count - 1)
+    values = np.empty(count)
     best_k = 0
-    best = math.inf
     for k in range(count):
-        value = _ring_distance(solid, centre, e1, e2, ring_radius, first + k * spacing, radius,
-                               half_length, start_angle, span, depth)
+        values[k] = _ring_distance(solid, centre, e1, e2, ring_radius, first + k * spacing,
+                                   radius, half_length, start_angle, span, depth)
+        if values[k] < values[best_k]:
+            best_k = k
+    theta, best = _golden_section(solid, centre, e1, e2, ring_radius, first, extent, is_arc,
+                                  spacing, best_k, values[best_k], radius, half_length,
+                                  start_angle, span, depth)
+    # The next sampled local minima, smallest first (a ring, periodic; an arc's ends count).
+    refined = np.zeros(count, dtype=np.bool_)
+    refined[best_k] = True
+    for _ in range(REFINED_BASINS - 1):
+        next_k = -1
+        for k in range(count):
+            if refined[k] or not _is_sampled_minimum(values, k, is_arc):
+                continue
+            if next_k < 0 or values[k] < values[next_k]:
+                next_k = k
+        if next_k < 0:
+            break
+        refined[next_k] = True
+        angle, value = _golden_section(solid, centre, e1, e2, ring_radius, first, extent,
+                                       is_arc, spacing, next_k, values[next_k], radius,
+                                       half_length, start_angle, span, depth)
         if value < best:
-            best_k, best = k, value
-    low = first + (best_k - 1) * spacing
-    high = first + (best_k + 1) * spacing
-    if is_arc:
-        low = max(low, first)
-        high = min(high, first + extent)
-    inner = high - _GOLDEN * (high - low)
-    outer = low + _GOLDEN * (high - low)
-    f_inner = _ring_distance(solid, centre, e1, e2, ring_radius, inner, radius, half_length,
-                             start_angle, span, depth)
-    f_outer = _ring_distance(solid, centre, e1, e2, ring_radius, outer, radius, half_length,
-                             start_angle, span, depth)
-    for _ in range(GOLDEN_STEPS):
-        if f_inner <= f_outer:
-            high, outer, f_outer = outer, inner, f_inner
-            inner = high - _GOLDEN * (high - low)
-            f_inner = _ring_distance(solid, centre, e1, e2, ring_radius, inner, radius, half_length,
-                                     start_angle, span, depth)
-        else:
-            low, inner, f_inner = inner, outer, f_outer
-            outer = low + _GOLDEN * (high - low)
-            f_outer = _ring_distance(solid, centre, e1, e2, ring_radius, outer, radius, half_length,
-                                     start_angle, span, depth)
-    theta = first + best_k * spacing
-    for candidate, value in ((inner, f_inner), (outer, f_outer)):
-        if value < best:
-            theta, best = candidate, value
+            theta, best = angle, value
     point = _ring_local_point(centre, e1, e2, ring_radius, theta)
     distance, gradient = _solid_distance(solid, radius, half_length, start_angle, span, depth,
                                          point)
