@@ -14,7 +14,19 @@ import numpy as np
 
 from clearbench.kernels.gaps.segments import segment_parameters
 from clearbench.kernels.gaps.staging import stage_contact
-from clearbench.kernels.gaps.vectors import add, axpy, column_of, cross, dot, norm, scaled, sub
+from clearbench.kernels.gaps.vectors import (
+    add,
+    axpy,
+    clamp,
+    column_of,
+    cross,
+    dot,
+    norm,
+    scaled,
+    sub,
+    to_local,
+    to_world,
+)
 from clearbench.kernels.jit import njit
 
 #: Edge-edge axes with |a_i x b_j| below this are skipped in the box-box separating-axis test.
@@ -177,22 +189,18 @@ def box_box(position_a, rotation_a, half_a, position_b, rotation_b, half_b, stag
 @njit(cache=True, inline="always")
 def _nearest_in_box(point, position, rotation, half):
     """The point of the box's solid nearest ``point`` (3,)."""
-    nearest = (position[0], position[1], position[2])
-    relative = sub(point, position)
-    for k in range(3):
-        column = column_of(rotation, k)
-        nearest = axpy(min(max(dot(relative, column), -half[k]), half[k]), column, nearest)
-    return nearest
+    local = to_local(position, rotation, point)
+    return to_world(position, rotation, (clamp(local[0], -half[0], half[0]),
+                                         clamp(local[1], -half[1], half[1]),
+                                         clamp(local[2], -half[2], half[2])))
 
 
 @njit(cache=True, inline="always")
 def _corner(position, rotation, half, signs):
-    """The box's corner position + sum_k signs[k] half[k] column_k (signs: 3 of +-1; a
-    component 0 gives the middle of an edge along that axis)."""
-    corner = (position[0], position[1], position[2])
-    for k in range(3):
-        corner = axpy(signs[k] * half[k], column_of(rotation, k), corner)
-    return corner
+    """The box's point at local (signs[k] half[k]) (signs: 3 of +-1 for a corner; a component
+    0 gives the middle of an edge along that axis)."""
+    return to_world(position, rotation, (signs[0] * half[0], signs[1] * half[1],
+                                         signs[2] * half[2]))
 
 
 @njit(cache=True)
