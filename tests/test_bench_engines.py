@@ -14,11 +14,12 @@ def test_bench_engines_prints_each_contender_and_its_ratio(capsys):
     assert status == 0
     out = capsys.readouterr().out
     rows = [line.split() for line in out.splitlines() if line.startswith("pendulum")]
-    labels = [" ".join(row[1:-4]) for row in rows]
+    labels = [" ".join(row[1:-5]) for row in rows]
     assert labels == ["reference[default]", "reference[default] step_loop=python",
                       "mujoco[default]"]
-    assert all(row[-4] == "3" and row[-1] == "ok" for row in rows)
-    assert rows[0][-2] == "1"  # the reference's ratio to itself
+    assert all(row[-5] == "3" and row[-1] == "ok" for row in rows)
+    assert rows[0][-3] == "1"  # the reference's ratio to itself
+    assert "it/step" in out
     assert "median" in out
 
 
@@ -53,6 +54,29 @@ def test_a_hanging_or_crashing_contender_is_a_row_and_the_benchmark_goes_on():
     # no measured run after a warm-up that hung: no cost
     assert costs[1].message.startswith("warm-up:") and math.isnan(costs[1].seconds_per_step)
     assert costs[3].steps == 4 and costs[3].seconds_per_step > 0
+
+
+def test_iterations_per_step_are_the_runs_total_over_its_steps():
+    # The bench's iterations per step are the run's own: the same deterministic reference run
+    # made directly gives the same total (its samples' sum) over the same steps. A mean over
+    # the 10 recorded samples alone would be about 10 times too large (each sample adds up the
+    # steps since the one before). Exact equality: the same code on the same input.
+    import importlib
+
+    import numpy as np
+
+    from clearbench.adapters import ENGINES
+    from clearbench.adapters.base import RunSettings
+    from clearbench.harness.studies.benchmarks.engine_costs import Contender, measure
+    from clearbench.scenarios.library import get_scene
+
+    steps = 40
+    [cost] = measure(["sliding-box"], [Contender("reference", "default")], steps=steps)
+    scene = get_scene("sliding-box")
+    trajectory = importlib.import_module(ENGINES["reference"]).create().run(
+        scene, RunSettings(horizon=steps * scene.time_step, record_every=steps // 10))
+    assert cost.steps == steps
+    assert cost.iterations_per_step == np.sum(trajectory.solver_iterations) / steps > 0
 
 
 def test_bench_engines_against_refuses_the_contenders_options(capsys):

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import math
 import statistics
 import sys
 from collections.abc import Callable
@@ -152,17 +153,22 @@ def bench_engines(args: argparse.Namespace) -> int:
     print(f"Stepping cost per step [us] (stepping_seconds / steps of one run of at most "
           f"{args.steps} steps, after an untimed warm-up run), and its ratio to {reference}; "
           "the contenders in turn on each scene, in one worker process, "
-          f"each run limited to {args.timeout:g} s")
+          f"each run limited to {args.timeout:g} s; it/step: the contact solver's iterations "
+          "per step over the run ('-' where the engine reports none, as Drake, or nothing "
+          "was solved)")
     print(f"{'scene':<27} {'engine[preset]':<36} {'steps':>6} {'us/step':>10} "
-          f"{'x ref':>8}  status")
+          f"{'x ref':>8} {'it/step':>8}  status")
     base: dict[str, float] = {}
 
     def report(cost: engine_costs.EngineCost) -> None:
         if cost.contender == reference:
             base[cost.scene] = cost.seconds_per_step
         ratio = cost.seconds_per_step / base.get(cost.scene, float("nan"))
+        iterations = (f"{cost.iterations_per_step:.1f}"
+                      if math.isfinite(cost.iterations_per_step) else "-")
         print(f"{cost.scene:<27} {cost.contender:<36} {cost.steps:>6} "
-              f"{1e6 * cost.seconds_per_step:>10.1f} {ratio:>8.3g}  {cost.status}"
+              f"{1e6 * cost.seconds_per_step:>10.1f} {ratio:>8.3g} {iterations:>8}  "
+              f"{cost.status}"
               + (f": {cost.message[:60]}" if cost.message else ""), flush=True)
 
     costs = engine_costs.measure(scenes, contenders, args.steps, report, args.timeout,

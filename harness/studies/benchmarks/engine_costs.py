@@ -7,8 +7,10 @@ on all of them alike. The runs go through the harness's isolated worker
 with a wall-clock limit per run: an engine that hangs, crashes or diverges is a row with its
 status, and the benchmark goes on with a fresh worker. A contender's first run of a scene is
 a short warm-up (it compiles, loads caches), untimed; the measured run's cost per step is its
-``stepping_seconds / steps``, as the run store's ``stepping_seconds_per_step``. The figures
-are printed; nothing is asserted about time.
+``stepping_seconds / steps``, as the run store's ``stepping_seconds_per_step``, and its
+contact solver's iterations per step the run's total (every engine adds up its steps'
+iterations into the next recorded sample, so the samples' sum is the run's total) over its
+steps. The figures are printed; nothing is asserted about time.
 """
 
 from __future__ import annotations
@@ -46,8 +48,9 @@ class Contender:
 
 @dataclass(frozen=True)
 class EngineCost:
-    """One measured run: ``seconds_per_step`` [s] (NaN when it did not run: ``status``,
-    ``message`` say why)."""
+    """One measured run: ``seconds_per_step`` [s] and ``iterations_per_step`` (the contact
+    solver's, mean over the run's steps; NaN when the run reports none, as Drake's, or did not
+    run: ``status``, ``message`` say why)."""
 
     scene: str
     contender: str
@@ -55,6 +58,7 @@ class EngineCost:
     seconds_per_step: float
     status: str
     message: str = ""
+    iterations_per_step: float = math.nan
 
 
 def available_contenders(engines: list[str] | None = None) -> list[Contender]:
@@ -110,11 +114,23 @@ def _measure_one(runner: Runner, scene: str, contender: Contender, dt: float, ho
     if record["status"] in (RunStatus.CRASHED.value, RunStatus.TIMED_OUT.value):
         return EngineCost(scene, contender.label, 0, math.nan, record["status"],
                           f"warm-up: {record['message']}")
-    record = _run(runner, spec(horizon, max(1, steps // 10)))
+    measured = spec(horizon, max(1, steps // 10))
+    record = _run(runner, measured)
     ran = int(record["steps"] or 0)
     per_step = record["stepping_seconds"] / ran if ran > 0 else math.nan
     message = record["message"] if record["status"] != RunStatus.OK.value else ""
-    return EngineCost(scene, contender.label, ran, per_step, record["status"], message)
+    return EngineCost(scene, contender.label, ran, per_step, record["status"], message,
+                      _iterations_per_step(runner.store.load_trajectory(measured.key), ran))
+
+
+def _iterations_per_step(trajectory, steps: int) -> float:
+    """The run's contact-solver iterations over its ``steps``: the recorded samples' sum (each
+    sample holds the iterations of the steps since the one before). NaN without a trajectory,
+    a step or an iteration (an engine that reports none, or a run with no contact solve)."""
+    if trajectory is None or steps < 1:
+        return math.nan
+    total = int(trajectory.solver_iterations.sum())
+    return total / steps if total > 0 else math.nan
 
 
 def _run(runner: Runner, spec) -> dict:
