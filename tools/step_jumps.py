@@ -19,12 +19,12 @@ checkout.
 from __future__ import annotations
 
 import argparse
-import json
 
 import numpy as np
 
 from clearbench.adapters.base import RunSettings
 from clearbench.adapters.reference import create
+from clearbench.harness.run.spec import parse_assignment
 from clearbench.scenarios.library import get_scene
 
 
@@ -45,12 +45,12 @@ def main(argv=None) -> int:
     parser.add_argument("--factor", type=float, default=10.0,
                         help="a step is a jump above this multiple of the window's median")
     parser.add_argument("--option", action="append", default=[], metavar="NAME=VALUE",
-                        help="reference engine option (value as JSON)")
+                        help="reference engine option, read as `clearbench run --option` reads it")
     args = parser.parse_args(argv)
-    options = {}
-    for item in args.option:
-        name, _, value = item.partition("=")
-        options[name] = json.loads(value)
+    try:
+        options = dict(parse_assignment(item, "--option") for item in args.option)
+    except ValueError as error:
+        parser.error(str(error))
     scene = get_scene(args.scene)
     trajectory = create().run(scene, RunSettings(time_step=args.dt, horizon=args.horizon,
                                                  record_every=1, options=options))
