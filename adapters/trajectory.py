@@ -125,6 +125,13 @@ class Trajectory:
               "contact_normal_force", "contact_force", "solver_iterations", "solver_residual",
               "solver_converged", "active_contacts")
 
+    @property
+    def iterations_per_step(self) -> float:
+        """The contact solver's iterations per step of the run [-]: the recorded samples' sum
+        (a sample holds the iterations of every step since the sample before) over the run's
+        steps; 0 for a run without a step or from an engine that reports none."""
+        return float(np.sum(self.solver_iterations)) / self.steps if self.steps > 0 else 0.0
+
     def body_index(self, name: str) -> int:
         return self.body_names.index(name)
 

@@ -83,3 +83,29 @@ def test_bench_engines_against_refuses_the_contenders_options(capsys):
     assert main(["bench", "engines", "--against", "HEAD", "--python-loop",
                  "--scene", "pendulum"]) == 2
     assert "--python-loop" in capsys.readouterr().err
+
+
+def test_the_iterations_figure_is_per_step_whatever_the_recording():
+    # The run figure solver_iterations_per_step is the run's total over its steps: the same
+    # deterministic reference run recorded every step and every 10 steps gives the same figure
+    # (the samples' sums are the same total), where a mean over recorded samples would differ
+    # tenfold. Equality to round-off of a division (the same integers summed).
+    import importlib
+
+    import pytest
+
+    from clearbench.adapters import ENGINES
+    from clearbench.adapters.base import RunSettings
+    from clearbench.harness.measure.figures import measure
+    from clearbench.scenarios.library import get_scene
+
+    scene = get_scene("sliding-box")
+    engine = importlib.import_module(ENGINES["reference"]).create()
+    figures = []
+    for record_every in (1, 10):
+        trajectory = engine.run(scene, RunSettings(horizon=40 * scene.time_step,
+                                                   record_every=record_every))
+        figures.append(measure(scene, trajectory).figures["solver_iterations_per_step"])
+        assert figures[-1] == pytest.approx(trajectory.iterations_per_step, rel=1e-15)
+    assert figures[0] > 0
+    assert figures[1] == pytest.approx(figures[0], rel=1e-15)

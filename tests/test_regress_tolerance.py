@@ -90,7 +90,7 @@ def test_nan_passes_only_where_it_was_measured():
 
 
 def test_iteration_counts_get_a_floor_of_whole_iterations():
-    check = classify("solver_iterations_mean", RIGID, 1.08, [1.08, 1.08], 1.0)
+    check = classify("solver_iterations_per_step", RIGID, 1.08, [1.08, 1.08], 1.0)
     # 5 % of 1.08 plus half an iteration.
     assert check.limit == pytest.approx(0.05 * 1.08 + 0.5)
     assert check.allows(1.5) and not check.allows(2.2)
@@ -104,7 +104,7 @@ def test_figure_dimensions():
     assert figure_dimension("stick.creep_rate") == "velocity"
     assert figure_dimension("energy_scale") == "energy"
     assert figure_dimension("joint_angle_max") == "angle"
-    assert figure_dimension("solver_iterations_mean") == "count"
+    assert figure_dimension("solver_iterations_per_step") == "count"
     assert figure_dimension("something_new") == "relative"
 
 

@@ -49,7 +49,8 @@ scene is absent.
 ``EXPECTATION.FIGURE``                   every figure of every expectation (expectation_figures)
 ``solver_unconverged_steps``             recorded steps whose one-step problem did not converge
 ``solver_residual_max``                  largest recorded residual (engine's measure) [-]
-``solver_iterations_mean``               mean recorded iterations
+``solver_iterations_per_step``           contact-solver iterations per step of the run
+                                         (``Trajectory.iterations_per_step``)
 =======================================  =====================================================
 
 Verdict (for a run the engine finished): ``diverged`` when a value is not finite, when energy
@@ -200,7 +201,7 @@ def _solver_figures(trajectory: Trajectory, out: _Collector) -> None:
     residual = np.asarray(trajectory.solver_residual, dtype=float)
     if np.isfinite(residual).any():
         out.put("solver_residual_max", float(np.nanmax(residual)))
-    out.put("solver_iterations_mean", float(np.mean(trajectory.solver_iterations)))
+    out.put("solver_iterations_per_step", trajectory.iterations_per_step)
 
 
 def measure(scene: Scene, trajectory: Trajectory, reference: Trajectory | None = None,

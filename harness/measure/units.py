@@ -45,7 +45,7 @@ RUN_FIGURES: dict[str, FigureUnit] = {
     "energy_growth_contact_free": of("energy_scale"), "error": of("the reference value"),
     "solver_unconverged_steps": FigureUnit(word="steps"),
     "solver_residual_max": FigureUnit(word="engine's measure"),
-    "solver_iterations_mean": FigureUnit(word="iterations"),
+    "solver_iterations_per_step": FigureUnit(word="iterations"),
     "instrument_penetration_max": L, "instrument_resolution_max": L,
     "instrument_difference_max": L, "instrument_clearance_excess_max": L,
     "unseen_penetration": L, "unseen_penetration_time": T,

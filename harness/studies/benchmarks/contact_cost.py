@@ -12,8 +12,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
 from clearbench.adapters.base import Engine, RunSettings
 from clearbench.scenarios.library.basic import box_grid
 
@@ -59,8 +57,7 @@ def contact_costs(engines: dict[str, Engine], boxes=DEFAULT_BOXES, time_steps=(1
                 trajectory = engine.run(scene, RunSettings(time_step=time_step, horizon=horizon,
                                                            options=dict(options or {})))
                 steps = max(trajectory.steps, 1)
-                iterations = float(np.sum(trajectory.solver_iterations)) / steps \
-                    if len(trajectory.solver_iterations) else math.nan
+                iterations = trajectory.iterations_per_step if trajectory.steps else math.nan
                 engine_steps = trajectory.metadata.get("solver_steps")
                 rows.append(ContactCost(label, count, time_step, trajectory.status.value,
                                         trajectory.message,

@@ -124,13 +124,13 @@ def _measure_one(runner: Runner, scene: str, contender: Contender, dt: float, ho
 
 
 def _iterations_per_step(trajectory, steps: int) -> float:
-    """The run's contact-solver iterations over its ``steps``: the recorded samples' sum (each
-    sample holds the iterations of the steps since the one before). NaN without a trajectory,
-    a step or an iteration (an engine that reports none, or a run with no contact solve)."""
+    """The run's contact-solver iterations per step (``Trajectory.iterations_per_step``) over
+    the ``steps`` the runner's record says it took. NaN without a trajectory, a step or an
+    iteration (an engine that reports none, or a run with no contact solve)."""
     if trajectory is None or steps < 1:
         return math.nan
-    total = int(trajectory.solver_iterations.sum())
-    return total / steps if total > 0 else math.nan
+    per_step = trajectory.iterations_per_step
+    return per_step if per_step > 0 else math.nan
 
 
 def _run(runner: Runner, spec) -> dict:
