@@ -69,6 +69,7 @@ from clearbench.ref_solver.projection_kernel import (
     MAX_PROJECTION_HALVINGS,
     candidates,
     closed_gap_limit,
+    closed_gap_slack,
     geometry_arrays,
     project,
 )
@@ -99,7 +100,8 @@ class StepperSettings:
         Contacts whose gap at the start of the step is below this are active from the start
         of the step [L].
     length_scale : float
-        Characteristic length [L] for finite-difference steps of the spring stiffness.
+        Characteristic length [L] (the scene's largest): finite-difference steps of the
+        spring stiffness, and the round-off of gaps (``projection_kernel.closed_gap_slack``).
     method : str
         ``nsgs``, ``newton`` or ``hybrid`` (NSGS for at most ``hybrid_sweeps`` sweeps, then
         Newton from where it stopped).
@@ -699,7 +701,7 @@ class MoreauJeanStepper:
                                     & (u_new[:, 0] <= 0.5 * cfg.restitution_threshold))[0]:
                     closed[pairs[c], slots[c]] = closed_gap_limit(
                         cand[0][pairs[c], slots[c]], u_start[c], u_new[c], h,
-                        cfg.position_tolerance)
+                        closed_gap_slack(cfg.position_tolerance, cfg.length_scale))
         else:
             solve = _NO_SOLVE
         new_nu[sys_.body_fixed] = 0.0

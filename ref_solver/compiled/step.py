@@ -129,7 +129,7 @@ def _velocity_stage(s, cfg, memory, t, h, x, p, v, omega, rotation, nu, free, in
                 if r[nbil + 3 * c] > floor and u_new[3 * c] <= 0.5 * cfg.restitution_threshold:
                     closed[pairs[c], slots[c]] = closed_gap_limit(
                         cand[0][pairs[c], slots[c]], u_start[3 * c:3 * c + 3],
-                        u_new[3 * c:3 * c + 3], h, cfg.position_tolerance)
+                        u_new[3 * c:3 * c + 3], h, cfg.closed_gap_slack)
     for b in range(s.fixed.shape[0]):
         if s.fixed[b]:
             new_nu[b] = 0.0
