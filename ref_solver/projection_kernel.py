@@ -13,6 +13,8 @@ order of :func:`constraints.contact_candidates` and :func:`constraints.bilateral
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
@@ -70,12 +72,51 @@ def selected_candidates(arrays, x, rotation, selected):
     return gap, point_a, point_b, frame, count
 
 
+#: Round-off of a contact's gap relative to the scene's largest feature length: a gap is
+#: computed from world positions through rotations and the gap kernel's nearest points, and
+#: varies by hundreds of units in the last place of that length from step to step (measured:
+#: closed slots at rest whose gap after the velocity stage is 1e-13 to 1e-12 mm on the C-60,
+#: largest feature 7.8 mm, on the half-speed trip test's python loop). 1e-10 of the length
+#: (7.8e-10 mm there) is over 700 times the largest of those, and 1e-7 or less of a change of
+#: candidate that :func:`closed_gap_limit` exists to catch (0.06 mm on the C-60's trip).
+GAP_ROUNDOFF = 1e-10
+
+
+def closed_gap_slack(position_tolerance, length_scale):
+    """The slack [L] of :func:`closed_gap_limit`: the projection's ``position_tolerance`` [L]
+    or the gaps' round-off (:data:`GAP_ROUNDOFF` of the scene's ``length_scale`` [L]), the
+    larger. Without the round-off, a closed slot at rest whose gap after the velocity stage
+    is a few 1e-13 mm read as having taken another candidate and was left unilateral."""
+    return max(position_tolerance, GAP_ROUNDOFF * length_scale)
+
+
+@njit(cache=True)
+def closed_gap_limit(gap_start, velocity_start, velocity_end, h, slack):
+    """The largest gap [L] at which a contact slot that closed in the velocity stage still holds
+    that contact at the projection: its gap at the step's start ``gap_start`` (0 if
+    penetrating) plus twice the travel of its points relative to each other over the step, h
+    (|velocity_start| + |velocity_end|) ([L/T], the contact-frame relative velocities at the
+    step's start and end, 3-vectors), plus ``slack`` [L] (:func:`closed_gap_slack`). The
+    same contact's gap changes by at most h times the larger of the two speeds, and by the
+    curvature of its surfaces by less again while a step's travel is below their radii; the
+    factor 2 covers both. A slot whose
+    gap exceeds it holds another candidate (the gap kernel's slot took another point while the
+    bodies moved, as a ring's minimum slot does when the minimum it held vanishes): Eq. (21)'s
+    equality g = 0 would pull that point onto the face, a jump of the body by its gap."""
+    speed_start = math.sqrt(velocity_start[0] ** 2 + velocity_start[1] ** 2
+                            + velocity_start[2] ** 2)
+    speed_end = math.sqrt(velocity_end[0] ** 2 + velocity_end[1] ** 2 + velocity_end[2] ** 2)
+    return max(gap_start, 0.0) + 2.0 * h * (speed_start + speed_end) + slack
+
+
 @njit(cache=True)
 def projection_rows(arrays, n_bilateral, t, x, p, active, closed):
     """Rows of the projection at (x, p): (row_body (m, 2), row_coef (m, 2, 6), values (m,)
     [L], n_equal, worst [L]), as ``MoreauJeanStepper._violations``: bilateral rows and the
     normal rows of the active contacts that hold a candidate here, equalities (bilateral rows,
-    contacts in ``closed``) first, then the unilateral rows, each group in row order; ``worst``
+    contacts whose gap here is at most their ``closed`` (npair, K) [L]: :func:`closed_gap_limit`
+    of those that closed in the velocity stage, -inf for the others) first, then the unilateral
+    rows, each group in row order; ``worst``
     is the largest equality violation or penetration."""
     rotation = rotation_matrices(p)
     # Only the pairs with an active slot make rows: the others are not evaluated.
@@ -114,7 +155,7 @@ def projection_rows(arrays, n_bilateral, t, x, p, active, closed):
                      point_a, point_b, frame, body_all, coef_all, n_bilateral)
     n_equal = n_bilateral
     for c in range(n_selected):
-        if closed[pairs[c], slots[c]]:
+        if gap[pairs[c], slots[c]] <= closed[pairs[c], slots[c]]:
             n_equal += 1
     m = n_bilateral + n_selected
     order = np.empty(m, dtype=np.int64)
@@ -126,7 +167,7 @@ def projection_rows(arrays, n_bilateral, t, x, p, active, closed):
     unilateral_fill = n_equal
     for c in range(n_selected):
         value = gap[pairs[c], slots[c]]
-        if closed[pairs[c], slots[c]]:
+        if value <= closed[pairs[c], slots[c]]:
             order[equal_fill] = n_bilateral + 3 * c
             values[equal_fill] = value
             equal_fill += 1

@@ -68,6 +68,8 @@ from clearbench.ref_solver.projection import solve_projection
 from clearbench.ref_solver.projection_kernel import (
     MAX_PROJECTION_HALVINGS,
     candidates,
+    closed_gap_limit,
+    closed_gap_slack,
     geometry_arrays,
     project,
 )
@@ -98,7 +100,8 @@ class StepperSettings:
         Contacts whose gap at the start of the step is below this are active from the start
         of the step [L].
     length_scale : float
-        Characteristic length [L] for finite-difference steps of the spring stiffness.
+        Characteristic length [L] (the scene's largest): finite-difference steps of the
+        spring stiffness, and the round-off of gaps (``projection_kernel.closed_gap_slack``).
     method : str
         ``nsgs``, ``newton`` or ``hybrid`` (NSGS for at most ``hybrid_sweeps`` sweeps, then
         Newton from where it stopped).
@@ -657,7 +660,7 @@ class MoreauJeanStepper:
         m = nbil + 3 * len(pairs)
         new_nu = free.copy()
         impulses = np.zeros_like(self.previous_impulse)
-        closed = np.zeros(active.shape, dtype=bool)
+        closed = np.full(active.shape, -np.inf)
         if m:
             # Joint Jacobians at the predicted configuration q_k + theta h v_k: with theta =
             # 1/2 this makes ideal joints second order in energy (at q_k the energy error is
@@ -688,12 +691,17 @@ class MoreauJeanStepper:
             impulses[pairs, slots] = solve.r[nbil:].reshape(-1, 3)
             if len(pairs):
                 # Contacts that stay closed: they carry a normal impulse and their normal
-                # velocity at the end of the step is (about) zero, not a rebound.
-                u_new = row_values(row_body, row_coef, new_nu, nbil, m)[0::3]
+                # velocity at the end of the step is (about) zero, not a rebound; each with the
+                # gap up to which its slot still holds it (closed_gap_limit).
+                u_new = row_values(row_body, row_coef, new_nu, nbil, m).reshape(-1, 3)
+                u_start = row_values(row_body, row_coef, nu, nbil, m).reshape(-1, 3)
                 normal_impulse = solve.r[nbil:][0::3]
                 floor = 1e-14 * max(float(np.max(np.abs(normal_impulse))), 1e-300)
-                closed[pairs, slots] = (normal_impulse > floor) & (
-                    u_new <= 0.5 * cfg.restitution_threshold)
+                for c in np.nonzero((normal_impulse > floor)
+                                    & (u_new[:, 0] <= 0.5 * cfg.restitution_threshold))[0]:
+                    closed[pairs[c], slots[c]] = closed_gap_limit(
+                        cand[0][pairs[c], slots[c]], u_start[c], u_new[c], h,
+                        closed_gap_slack(cfg.position_tolerance, cfg.length_scale))
         else:
             solve = _NO_SOLVE
         new_nu[sys_.body_fixed] = 0.0
@@ -719,11 +727,11 @@ class MoreauJeanStepper:
         Returns (iterations, largest remaining violation [L], converged)."""
         start_x, start_p = state.x.copy(), state.p.copy()
         iterations, worst, converged = self._project(state, active, closed)
-        if converged or not closed.any():
+        if converged or not np.isfinite(closed).any():
             return iterations, worst, converged
         best = (worst, state.x.copy(), state.p.copy())
         state.x[:], state.p[:] = start_x, start_p
-        more, worst, converged = self._project(state, active, np.zeros_like(closed))
+        more, worst, converged = self._project(state, active, np.full_like(closed, -np.inf))
         iterations += more
         if not converged and best[0] < worst:
             worst = best[0]
@@ -752,10 +760,12 @@ class MoreauJeanStepper:
         # gap it had (the velocity stage stops it, nothing brings the gap to zero). A
         # contact whose impulse is a rebound (normal velocity > 0 at the end of the step)
         # is left unilateral: pulling a bouncing body down to g = 0 would take away the
-        # potential energy of the gap at which the impact was captured.
+        # potential energy of the gap at which the impact was captured. Nor is a slot whose
+        # gap here exceeds its limit (``closed``: closed_gap_limit), which holds another
+        # candidate than the contact that carried the impulse.
         equality = np.arange(len(keep)) < nbil
         if len(pairs):
-            equality[nbil:][0::3] = closed[pairs, slots]
+            equality[nbil:][0::3] = cand[0][pairs, slots] <= closed[pairs, slots]
         equal = np.nonzero(keep & equality)[0]
         inequal = np.nonzero(keep & ~equality)[0]
         rows = np.concatenate((equal, inequal))

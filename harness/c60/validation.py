@@ -140,10 +140,19 @@ def _request(name: str) -> RunRequest:
     return RunRequest(name, scene, parameters, record_every)
 
 
+def _half_speed_parameters(scene_name: str) -> dict:
+    """The factory parameters of the bench test ``scene_name`` at half its probe's speed."""
+    return {"probe_speed": 0.5 * _probe_speed(get_scene(scene_name))}
+
+
+def half_speed_scene(scene_name: str) -> Scene:
+    """The bench test ``scene_name`` at half its probe's speed, as the speed check runs it."""
+    return get_scene(scene_name, **_half_speed_parameters(scene_name))
+
+
 def _half_speed(name: str, scene_name: str) -> RunRequest:
     """The bench test ``scene_name`` at half its probe's speed (the speed check)."""
-    speed = _probe_speed(get_scene(scene_name))
-    return RunRequest(name, scene_name, {"probe_speed": 0.5 * speed}, 40)
+    return RunRequest(name, scene_name, _half_speed_parameters(scene_name), 40)
 
 
 def validation_runs(speed_check: bool = True, sensitivity: bool = True) -> list[RunRequest]:

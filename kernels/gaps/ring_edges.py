@@ -54,6 +54,8 @@ _PARALLEL = 1e-6
 _RIM_REACH = 1e-4
 #: Face codes of a face solid's boundary (axis of the face's outward normal, with its side).
 _FACE_X, _FACE_Y, _FACE_Z, _FACE_RIM = 0, 1, 2, 3
+#: The unset point and normal of a candidate that is no edge contact.
+_NONE = (0.0, 0.0, 0.0)
 
 
 @njit(cache=True, inline="always")
@@ -128,47 +130,62 @@ def edge_continuation(theta, value, centre, e1, e2, radius, kind, size_1, size_2
 
     ``spacing`` [rad]: the minima search's sample spacing; ``low_limit``, ``high_limit``: an
     arc's ends (+-inf for a circle). Returns (is_edge, gap [L], point on the edge, unit normal
-    out of the solid), face frame; ``is_edge`` False (the other values
-    unset) where the minimum is not at an edge.
+    out of the solid), face frame; ``is_edge`` False (the other values unset) where the
+    minimum is not at an edge.
     """
-    none = (0.0, 0.0, 0.0)
     if kind == PLANE:
-        return False, 0.0, none, none
+        return False, 0.0, _NONE, _NONE
     near = ring_point(centre, e1, e2, radius, theta)
-    face_a, side_a, face_b, side_b, to_edge = _nearest_edge_faces(kind, size_1, size_2, depth,
-                                                                  near)
-    low, high = max(theta - spacing, low_limit), min(theta + spacing, high_limit)
+    to_edge = _nearest_edge_faces(kind, size_1, size_2, depth, near)[4]
     band = EDGE_BAND * radius
     if value < 0.0:
         # Inside: the deepest point of an arc cut off the edge lies on the edge's bisector,
         # sqrt(2) times its depth from the edge.
         if value < -band or to_edge > math.sqrt(2.0) * -value + band:
-            return False, 0.0, none, none
+            return False, 0.0, _NONE, _NONE
     elif to_edge > value + band:
-        return False, 0.0, none, none
+        return False, 0.0, _NONE, _NONE
+    return ring_edge_contact(theta, centre, e1, e2, radius, kind, size_1, size_2, depth,
+                             max(theta - spacing, low_limit), min(theta + spacing, high_limit))
+
+
+@njit(cache=True)
+def ring_edge_contact(theta, centre, e1, e2, radius, kind, size_1, size_2, depth, low, high):
+    """The ring against the line of the solid's edge nearest its point at ``theta``, along
+    their common normal, when the ring's point nearest that line lies within (low, high)
+    [rad] and on the edge itself (module docstring). Returns (is_edge, gap [L], point on the
+    edge, unit normal out of the solid), face frame; ``is_edge`` False (the other values
+    unset) otherwise: no edge (a plane), the ring's nearest point outside the window, the ring
+    along the edge, apart from it off their common normal, or past the edge's ends.
+    """
+    if kind == PLANE:
+        return False, 0.0, _NONE, _NONE
+    near = ring_point(centre, e1, e2, radius, theta)
+    face_a, side_a, face_b, side_b, _ = _nearest_edge_faces(kind, size_1, size_2, depth, near)
     edge_point, direction, outward = _edge_line(kind, size_1, size_2, depth, face_a, side_a,
                                                 face_b, side_b, near)
     offset = sub(centre, edge_point)
     angle = ring_angle(offset, e1, e2, radius, direction, low, high - low, True, 1.0)
     angle = low + (angle - low) % TWO_PI  # ring_angle's angle is modulo 2 pi
     if not low < angle < high:
-        # The ring's nearest point to the line is not within a sample of the minimum: the
-        # ring does not pass the edge there (a ring around a disc's rim in its plane).
-        return False, 0.0, none, none
+        # The ring's nearest point to the line is not within the window: the ring does not
+        # pass the edge there (a ring around a disc's rim in its plane).
+        return False, 0.0, _NONE, _NONE
     tangent = add(scaled(e1, -math.sin(angle)), scaled(e2, math.cos(angle)))
     normal = cross(tangent, direction)
     length = norm(normal)
     if not length > _PARALLEL:
-        return False, 0.0, none, none
+        return False, 0.0, _NONE, _NONE
     normal = scaled(normal, (1.0 if dot(normal, outward) >= 0.0 else -1.0) / length)
     distance, perpendicular = ring_axis_distance(angle, offset, e1, e2, radius, direction)
-    if distance > band and abs(dot(perpendicular, normal)) < (1.0 - _PARALLEL) * distance:
+    if (distance > EDGE_BAND * radius
+            and abs(dot(perpendicular, normal)) < (1.0 - _PARALLEL) * distance):
         # Apart, the ring and the line are not joined along their common normal (the nearest
         # point is no interior critical point of the distance): not an edge contact.
-        return False, 0.0, none, none
+        return False, 0.0, _NONE, _NONE
     on_ring = ring_point(centre, e1, e2, radius, angle)
     along = dot(sub(on_ring, edge_point), direction)
     if not _within_edge(kind, size_1, size_2, depth, edge_point, direction, along):
-        return False, 0.0, none, none
+        return False, 0.0, _NONE, _NONE
     gap = dot(sub(on_ring, edge_point), normal)
     return True, gap, sub(on_ring, scaled(normal, gap)), normal

@@ -30,9 +30,9 @@ from __future__ import annotations
 
 import math
 
-from clearbench.kernels.gaps.codes import TWO_PI
+from clearbench.kernels.gaps.codes import DISC, PLANE, TWO_PI
 from clearbench.kernels.gaps.face_solids import face_solid_distance
-from clearbench.kernels.gaps.ring_edges import edge_continuation, ring_point
+from clearbench.kernels.gaps.ring_edges import edge_continuation, ring_edge_contact, ring_point
 from clearbench.kernels.gaps.staging import stage_contact
 from clearbench.kernels.gaps.vectors import (
     column_of,
@@ -63,6 +63,15 @@ _AT_END = 1e-7
 _GOLDEN = 0.3819660112501051
 #: A projected face axis shorter than this picks the other axis for the support points' phase.
 _PHASE_AXIS_MIN = 0.5
+#: |ring axis . face normal| at or above this (the ring's plane within 45 degrees of the
+#: face's), the ring lies on the face: its support points beyond the face's bound move to the
+#: crossings (:func:`_stage_support`). A ring steeper than that rests on its lowest point or on
+#: the edge it crosses (the minima), which the support points would only duplicate: a duplicate
+#: of the edge contact of a hoop pivoting on an edge, swapping slots as the hoop turned, spun it.
+_LYING = math.cos(0.25 * math.pi)
+#: Bisections locating where the ring crosses the face's bound between two support points (at
+#: most 120 degrees apart): the angle to 2^-40 of that, below 2e-12 rad.
+_BOUND_BISECTIONS = 40
 
 
 @njit(cache=True, inline="always")
@@ -143,6 +152,84 @@ def _stage_ring_point(index, theta, centre, e1, e2, radius, kind, size_1, size_2
 
 
 @njit(cache=True, inline="always")
+def _beyond_bound(kind, size_1, size_2, point):
+    """How far [L] the face-frame ``point``'s projection on the face's plane lies beyond the
+    face's bound (> 0 beyond it; a plane has none: -inf)."""
+    if kind == PLANE:
+        return -math.inf
+    if kind == DISC:
+        return math.hypot(point[0], point[1]) - size_1
+    return max(abs(point[0]) - size_1, abs(point[1]) - size_2)
+
+
+@njit(cache=True, inline="always")
+def _point_beyond(theta, centre, e1, e2, radius, kind, size_1, size_2):
+    """True if the ring point at ``theta`` lies beyond the face's bound (projected)."""
+    return _beyond_bound(kind, size_1, size_2, ring_point(centre, e1, e2, radius, theta)) > 0.0
+
+
+@njit(cache=True)
+def _bound_crossing(outside, inside, centre, e1, e2, radius, kind, size_1, size_2):
+    """Angle [rad] where the ring crosses the face's bound between its point at ``outside``
+    (beyond the bound) and at ``inside`` (within it), by bisection; the angle returned is on
+    the bound's inner side."""
+    for _ in range(_BOUND_BISECTIONS):
+        middle = 0.5 * (outside + inside)
+        if _point_beyond(middle, centre, e1, e2, radius, kind, size_1, size_2):
+            outside = middle
+        else:
+            inside = middle
+    return inside
+
+
+@njit(cache=True)
+def _stage_support(k, phase, step, count, is_arc, centre, e1, e2, radius, kind, size_1, size_2,
+                   depth, low_limit, high_limit, spacing, face_position, face_rotation, stage):
+    """Stage support point ``k`` of ``count``, at ``phase + k * step`` [rad]; one beyond the
+    face's bound next to a support within it is moved along the ring to where the ring crosses
+    the bound (the nearer crossing when both neighbours are within), as a box's corners beyond
+    a face give way to the clipped polygon's vertices on its bound: a ring lying across the
+    bound is then held up at the crossings, whatever its own frame, not only by the supports
+    on one side of its centre. There the contact is the ring against the edge line
+    (:func:`~.ring_edges.ring_edge_contact`) where that holds, else the ring point's distance to
+    the solid."""
+    theta = phase + k * step
+    if not _point_beyond(theta, centre, e1, e2, radius, kind, size_1, size_2):
+        _stage_ring_point(k, theta, centre, e1, e2, radius, kind, size_1, size_2, depth,
+                          face_position, face_rotation, stage)
+        return
+    previous_within = (k > 0 or not is_arc) and not _point_beyond(
+        theta - step, centre, e1, e2, radius, kind, size_1, size_2)
+    next_within = (k < count - 1 or not is_arc) and not _point_beyond(
+        theta + step, centre, e1, e2, radius, kind, size_1, size_2)
+    if previous_within and next_within:
+        before = _bound_crossing(theta, theta - step, centre, e1, e2, radius, kind, size_1,
+                                 size_2)
+        after = _bound_crossing(theta, theta + step, centre, e1, e2, radius, kind, size_1,
+                                size_2)
+        theta = before if theta - before < after - theta else after
+    elif previous_within:
+        theta = _bound_crossing(theta, theta - step, centre, e1, e2, radius, kind, size_1,
+                                size_2)
+    elif next_within:
+        theta = _bound_crossing(theta, theta + step, centre, e1, e2, radius, kind, size_1,
+                                size_2)
+    else:
+        _stage_ring_point(k, theta, centre, e1, e2, radius, kind, size_1, size_2, depth,
+                          face_position, face_rotation, stage)
+        return
+    is_edge, gap, on_edge, normal = ring_edge_contact(
+        theta, centre, e1, e2, radius, kind, size_1, size_2, depth,
+        max(theta - spacing, low_limit), min(theta + spacing, high_limit))
+    if is_edge:
+        stage_contact(stage, k, gap, to_world(face_position, face_rotation, on_edge),
+                      rotate(face_rotation, normal))
+    else:
+        _stage_ring_point(k, theta, centre, e1, e2, radius, kind, size_1, size_2, depth,
+                          face_position, face_rotation, stage)
+
+
+@njit(cache=True, inline="always")
 def _support_phase(e1, e2):
     """Angle, in the ring's frame, of the face's x axis projected on the ring's plane (its y
     axis when x is within 30 degrees of the ring's axis): the first support point of a circle,
@@ -185,9 +272,18 @@ def ring_face(kind, size_1, size_2, depth, face_position, face_rotation, ring_po
         per_gap = _SAMPLES_PER_TURN // SUPPORT_POINTS
         samples = _SAMPLES_PER_TURN
         spacing = TWO_PI / samples
+    low_limit, high_limit = (phase, phase + span) if is_arc else (-math.inf, math.inf)
+    # The ring's axis against the face's normal (z): within _LYING of it, the ring lies on the
+    # face and its support points beyond the bound move to where it crosses the bound.
+    lying = abs(e1[0] * e2[1] - e1[1] * e2[0]) >= _LYING
     for k in range(SUPPORT_POINTS):
-        _stage_ring_point(k, phase + k * per_gap * spacing, centre, e1, e2, radius, kind,
-                          size_1, size_2, depth, face_position, face_rotation, stage)
+        if lying:
+            _stage_support(k, phase, per_gap * spacing, SUPPORT_POINTS, is_arc, centre, e1,
+                           e2, radius, kind, size_1, size_2, depth, low_limit, high_limit,
+                           spacing, face_position, face_rotation, stage)
+        else:
+            _stage_ring_point(k, phase + k * per_gap * spacing, centre, e1, e2, radius, kind,
+                              size_1, size_2, depth, face_position, face_rotation, stage)
     # The samples' discrete local minima (the two lowest), and the two highest samples that
     # are not support points (fills). The cyclic neighbours of a circle's first and last
     # samples are each other; an arc's ends compare with their one neighbour.
@@ -255,7 +351,6 @@ def ring_face(kind, size_1, size_2, depth, face_position, face_rotation, ring_po
         found_angle = (found_angle[1], found_angle[0])
         found_value = (found_value[1], found_value[0])
     fills = (phase + high_index * spacing, phase + higher_index * spacing)
-    low_limit, high_limit = (phase, phase + span) if is_arc else (-math.inf, math.inf)
     for m in range(MINIMA):
         theta = found_angle[m] if m < found else fills[m - found]
         if m < found:

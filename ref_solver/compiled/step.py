@@ -13,7 +13,7 @@ from clearbench.ref_solver.compiled.contact_solve import solve
 from clearbench.ref_solver.constraints import contact_rows, row_values
 from clearbench.ref_solver.forces import rotation_matrices
 from clearbench.ref_solver.gyroscopic import integrate_orientations
-from clearbench.ref_solver.projection_kernel import candidates, project
+from clearbench.ref_solver.projection_kernel import candidates, closed_gap_limit, project
 from clearbench.ref_solver.step_kernels import free_velocity, velocity_problem
 
 
@@ -80,7 +80,9 @@ def _finite(a):
 def _velocity_stage(s, cfg, memory, t, h, x, p, v, omega, rotation, nu, free, inverse, cand,
                     active, history):
     """``MoreauJeanStepper._velocity_stage``: (x, p, v, omega at t + h, impulses
-    (npair, K, 3), closed (npair, K), solver iterations, residual, converged, sweeps)."""
+    (npair, K, 3), closed (npair, K) [L]: the gap up to which a contact that stays closed is
+    an equality of the projection, -inf for the others; solver iterations, residual,
+    converged, sweeps)."""
     previous_impulse, previous_bilateral, newton_first = memory[0], memory[1], memory[2]
     theta = cfg.theta
     pairs, slots = _selected(valid_slots(cand[4], active))
@@ -89,7 +91,7 @@ def _velocity_stage(s, cfg, memory, t, h, x, p, v, omega, rotation, nu, free, in
     m = nbil + 3 * nc
     new_nu = free.copy()
     impulses = np.zeros_like(previous_impulse)
-    closed = np.zeros(active.shape, dtype=np.bool_)
+    closed = np.full(active.shape, -np.inf)
     iterations, residual, converged, sweeps = 0, 0.0, True, 0
     if m:
         w, y, q, row_body, row_coef, _, _ = velocity_problem(
@@ -115,15 +117,19 @@ def _velocity_stage(s, cfg, memory, t, h, x, p, v, omega, rotation, nu, free, in
             for a in range(3):
                 impulses[pairs[c], slots[c], a] = r[nbil + 3 * c + a]
         if nc:
-            # Contacts that stay closed: a normal impulse and no rebound (see the stepper).
+            # Contacts that stay closed: a normal impulse and no rebound (see the stepper),
+            # with the gap up to which their slot still holds them.
             u_new = row_values(row_body, row_coef, new_nu, nbil, m)
+            u_start = row_values(row_body, row_coef, nu, nbil, m)
             largest = 0.0
             for c in range(nc):
                 largest = max(largest, abs(r[nbil + 3 * c]))
             floor = 1e-14 * max(largest, 1e-300)
             for c in range(nc):
-                closed[pairs[c], slots[c]] = (r[nbil + 3 * c] > floor) and (
-                    u_new[3 * c] <= 0.5 * cfg.restitution_threshold)
+                if r[nbil + 3 * c] > floor and u_new[3 * c] <= 0.5 * cfg.restitution_threshold:
+                    closed[pairs[c], slots[c]] = closed_gap_limit(
+                        cand[0][pairs[c], slots[c]], u_start[3 * c:3 * c + 3],
+                        u_new[3 * c:3 * c + 3], h, cfg.closed_gap_slack)
     for b in range(s.fixed.shape[0]):
         if s.fixed[b]:
             new_nu[b] = 0.0
@@ -143,13 +149,13 @@ def _projection_stage(s, cfg, t, x, p, active, closed):
         s.geometry, s.n_bilateral, t, x, p, active, closed, s.projection_inverse,
         s.single_cluster, s.single_dofs, s.single_start, cfg.position_tolerance,
         cfg.max_projection_iterations)
-    if converged or not closed.any():
+    if converged or not np.isfinite(closed).any():
         return iterations, worst, converged
     best_worst, best_x, best_p = worst, x.copy(), p.copy()
     x[:] = start_x
     p[:] = start_p
     more, worst, converged = project(
-        s.geometry, s.n_bilateral, t, x, p, active, np.zeros_like(closed),
+        s.geometry, s.n_bilateral, t, x, p, active, np.full_like(closed, -np.inf),
         s.projection_inverse, s.single_cluster, s.single_dofs, s.single_start,
         cfg.position_tolerance, cfg.max_projection_iterations)
     iterations += more

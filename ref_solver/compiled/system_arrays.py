@@ -14,6 +14,7 @@ import numpy as np
 
 from clearbench.ref_solver.compiled.contact_solve import METHOD_CODES
 from clearbench.ref_solver.fc3d_local import LOCAL_KIND
+from clearbench.ref_solver.projection_kernel import closed_gap_slack
 
 
 class CompiledSystem(NamedTuple):
@@ -75,6 +76,7 @@ class LoopSettings(NamedTuple):
     check_interval: int
     roundoff_floor: bool
     proximal_rescue: float          # StepperSettings.proximal_rescue (0: off)
+    closed_gap_slack: float         # projection_kernel.closed_gap_slack [L]
 
 
 def compile_system(stepper) -> tuple[CompiledSystem, LoopSettings]:
@@ -111,7 +113,8 @@ def compile_system(stepper) -> tuple[CompiledSystem, LoopSettings]:
         local_max_iterations=int(solver.local_max_iterations),
         check_interval=int(solver.residual_check_interval),
         roundoff_floor=bool(solver.roundoff_floor),
-        proximal_rescue=float(cfg.proximal_rescue))
+        proximal_rescue=float(cfg.proximal_rescue),
+        closed_gap_slack=float(closed_gap_slack(cfg.position_tolerance, cfg.length_scale)))
     return system, settings
 
 
