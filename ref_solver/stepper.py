@@ -697,11 +697,11 @@ class MoreauJeanStepper:
                 u_start = row_values(row_body, row_coef, nu, nbil, m).reshape(-1, 3)
                 normal_impulse = solve.r[nbil:][0::3]
                 floor = 1e-14 * max(float(np.max(np.abs(normal_impulse))), 1e-300)
+                slack = closed_gap_slack(cfg.position_tolerance, cfg.length_scale)
                 for c in np.nonzero((normal_impulse > floor)
                                     & (u_new[:, 0] <= 0.5 * cfg.restitution_threshold))[0]:
                     closed[pairs[c], slots[c]] = closed_gap_limit(
-                        cand[0][pairs[c], slots[c]], u_start[c], u_new[c], h,
-                        closed_gap_slack(cfg.position_tolerance, cfg.length_scale))
+                        cand[0][pairs[c], slots[c]], u_start[c], u_new[c], h, slack)
         else:
             solve = _NO_SOLVE
         new_nu[sys_.body_fixed] = 0.0

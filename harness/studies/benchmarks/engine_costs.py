@@ -120,14 +120,14 @@ def _measure_one(runner: Runner, scene: str, contender: Contender, dt: float, ho
     per_step = record["stepping_seconds"] / ran if ran > 0 else math.nan
     message = record["message"] if record["status"] != RunStatus.OK.value else ""
     return EngineCost(scene, contender.label, ran, per_step, record["status"], message,
-                      _iterations_per_step(runner.store.load_trajectory(measured.key), ran))
+                      _iterations_per_step(runner.store.load_trajectory(measured.key)))
 
 
-def _iterations_per_step(trajectory, steps: int) -> float:
-    """The run's contact-solver iterations per step (``Trajectory.iterations_per_step``) over
-    the ``steps`` the runner's record says it took. NaN without a trajectory, a step or an
-    iteration (an engine that reports none, or a run with no contact solve)."""
-    if trajectory is None or steps < 1:
+def _iterations_per_step(trajectory) -> float:
+    """The run's contact-solver iterations per step (``Trajectory.iterations_per_step``). NaN
+    without a trajectory, a step or an iteration (an engine that reports none, or a run with
+    no contact solve)."""
+    if trajectory is None:
         return math.nan
     per_step = trajectory.iterations_per_step
     return per_step if per_step > 0 else math.nan
