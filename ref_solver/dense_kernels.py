@@ -12,7 +12,11 @@ import math
 import numpy as np
 from numba import njit
 
-from clearbench.ref_solver.fc3d_residual import natural_map_squared, normalised
+from clearbench.ref_solver.fc3d_residual import (
+    floor_of_velocity_error,
+    natural_map_squared,
+    normalised,
+)
 
 
 @njit(cache=True)
@@ -90,8 +94,6 @@ def roundoff_floor_dense(W: np.ndarray, r: np.ndarray, u: np.ndarray, q: np.ndar
                          mu: np.ndarray, use_max: bool) -> float:
     """:func:`fc3d_residual.roundoff_floor` for a dense W (m, m), without forming |W|."""
     m = q.size
-    eps = 2.220446049250313e-16
-    gamma = (m + 1) * eps / (1.0 - (m + 1) * eps)
     total = 0.0
     for i in range(m):
         acc = 0.0
@@ -99,12 +101,7 @@ def roundoff_floor_dense(W: np.ndarray, r: np.ndarray, u: np.ndarray, q: np.ndar
             acc += abs(W[i, j]) * abs(r[j])
         acc += abs(q[i])
         total += acc * acc
-    largest_mu = 0.0
-    for i in range(mu.size):
-        largest_mu = max(largest_mu, mu[i])
-    norm_r = math.sqrt(np.dot(r, r))
-    bound = (1.0 + largest_mu) * gamma * math.sqrt(total) + 2.0 * eps * norm_r
-    return normalised(bound, math.sqrt(np.dot(q, q)), norm_r, math.sqrt(np.dot(u, u)), use_max)
+    return floor_of_velocity_error(math.sqrt(total), r, u, q, mu, use_max)
 
 
 @njit(cache=True)

@@ -212,7 +212,7 @@ def solve_newton(
             nsgs_kernel(W.indptr, W.indices, W.data, q, mu, nb, bilateral_operator_of(problem),
                         r, u_tmp, LOCAL_KIND["ac"], options.tolerance, use_max, RESCUE_SWEEPS,
                         options.local_tolerance, options.local_max_iterations, RESCUE_SWEEPS,
-                        np.full(RESCUE_SWEEPS, np.nan), 0, 0)
+                        np.full(RESCUE_SWEEPS, np.nan), 0, 0, np.bool_(False))
         u, residual_q, residual_max, residual = measure(r, u_next)
         best_residual = min(best_residual, residual)
         history.append(residual)

@@ -198,7 +198,7 @@ def newton_dense_kernel(W, q, mu, n_bilateral, r, u, tolerance, use_max, max_ite
             nsgs_kernel(csr_indptr, csr_indices, csr_data, q, mu, n_bilateral, operator, r,
                         u_try, np.int64(_AC), tolerance, use_max, np.int64(RESCUE_SWEEPS),
                         local_tolerance, local_max_iterations, np.int64(RESCUE_SWEEPS),
-                        rescue_history, np.int64(0), np.int64(0))
+                        rescue_history, np.int64(0), np.int64(0), np.bool_(False))
             matvec_plus(W, r, q, u)
         _, residual_q, residual_max = residuals(r, u, q, mu, n_bilateral)
         residual = residual_max if use_max else residual_q

@@ -25,13 +25,12 @@ from clearbench.ref_solver.contact_problem import (
 )
 from clearbench.ref_solver.fc3d_local import LOCAL_FAILED, LOCAL_KIND, N_MAT, N_VEC, solve_local
 from clearbench.ref_solver.fc3d_residual import (
-    abs_operator_of,
     csr_matvec_plus,
     floor_message,
     hopeless,
     natural_map_squared,
     normalised,
-    roundoff_floor,
+    roundoff_floor_csr,
 )
 
 logger = logging.getLogger(__name__)
@@ -41,7 +40,10 @@ _STATUS_CODES = (
     SolverStatus.MAX_ITERATIONS,
     SolverStatus.STALLED,
     SolverStatus.NUMERICAL_FAILURE,
+    SolverStatus.CONVERGED,
 )
+#: :func:`nsgs_kernel`'s code of a residual accepted on its round-off floor.
+ROUNDOFF_CODE = 4
 _NO_OPERATOR = np.zeros((0, 0))
 _METHOD_NAMES = {name: f"nsgs-{name}" for name in LOCAL_KIND}
 
@@ -100,13 +102,17 @@ def nsgs_kernel(
     n_bilateral: int, bilateral_operator: np.ndarray, r: np.ndarray, u: np.ndarray, kind: int,
     tolerance: float, use_max: bool, max_sweeps: int, local_tolerance: float,
     local_max_iterations: int, check_interval: int, history: np.ndarray, stall_window: int,
-    stall_after: int,
+    stall_after: int, use_floor: bool,
 ) -> tuple[int, int, float, float, int, int]:
     """Run NSGS sweeps on r (in place); u receives W r + q at the last residual check.
 
     W is given by its CSR arrays (indptr (m + 1,), indices, data); its (3, 3) diagonal contact
     blocks are extracted here (one pass over the contact rows). The last sweep is always
-    checked. Returns (status code: 0 converged / 1 max iterations / 3 non-finite, sweeps done,
+    checked. With ``use_floor``, every check above the tolerance also tests the residual against
+    its round-off floor (:func:`fc3d_residual.roundoff_floor`), as the Newton kernels do at each
+    iteration: a residual the sweeps cannot tell from zero ends the solve (code 4) instead of
+    sweeping on to the cap. Returns (status code: 0 converged / 1 max iterations / 2 stalled /
+    3 non-finite / 4 converged to round-off, sweeps done,
     |F| / |q|, |F| / max(|q|, |r|, |u|) (NaN when non-finite), local failures in the last sweep,
     number of checks). ``history`` (>= max_sweeps,) receives the residual in the tested
     normalisation (``use_max``) of each check.
@@ -173,6 +179,10 @@ def nsgs_kernel(
             if residual <= tolerance:
                 status, sweeps = 0, sweep + 1
                 break
+            if use_floor and residual <= roundoff_floor_csr(indptr, indices, data, r, u, q, mu,
+                                                            use_max):
+                status, sweeps = ROUNDOFF_CODE, sweep + 1
+                break
             if 0 < stall_window < n_checks and n_checks >= stall_after and hopeless(
                     history[n_checks - 1 - stall_window], residual,
                     stall_window * check_interval, tolerance, max_sweeps - sweep - 1):
@@ -212,7 +222,7 @@ def solve_nsgs(
         LOCAL_KIND[options.local_solver],
         options.tolerance, use_max, options.max_iterations, options.local_tolerance,
         options.local_max_iterations, options.residual_check_interval, history,
-        options.stall_window, options.stall_after,
+        options.stall_window, options.stall_after, np.bool_(options.roundoff_floor),
     )
     if code == 0:
         return SolverResult(r, u, sweeps, residual_max if use_max else residual_q, residual_q,
@@ -220,13 +230,12 @@ def solve_nsgs(
                             history[:n_checks].copy())
     status = _STATUS_CODES[code]
     residual = residual_max if use_max else residual_q
-    if status in (SolverStatus.MAX_ITERATIONS, SolverStatus.STALLED) and options.roundoff_floor:
-        floor = roundoff_floor(abs_operator_of(problem), r, u, problem.q, problem.mu, use_max)
-        if residual <= floor:
-            return SolverResult(r, u, sweeps, residual, residual_q, residual_max, True,
-                                SolverStatus.CONVERGED, method,
-                                floor_message(residual, floor, options.tolerance), failures,
-                                history[:n_checks].copy())
+    if code == ROUNDOFF_CODE:
+        floor = roundoff_floor_csr(indptr, indices, data, r, u, problem.q, problem.mu, use_max)
+        return SolverResult(r, u, sweeps, residual, residual_q, residual_max, True,
+                            SolverStatus.CONVERGED, method,
+                            floor_message(residual, floor, options.tolerance), failures,
+                            history[:n_checks].copy())
     if status is SolverStatus.MAX_ITERATIONS:
         message = f"{sweeps} sweeps done, residual {history[n_checks - 1]:.3g} > " \
                   f"{options.tolerance:.3g}"

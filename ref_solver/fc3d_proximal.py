@@ -1,5 +1,5 @@
-"""Proximal-point Newton on a dense one-step problem: the hybrid chain's last attempt when every
-other one failed (``StepperSettings.proximal_rescue``).
+"""Proximal-point Newton on a dense one-step problem: the hybrid chain's attempt after its Newton
+attempts (from NSGS's end, the warm start and zero) failed (``StepperSettings.proximal_rescue``).
 
 The C-60's problems that the chain leaves unconverged have a rank-deficient Delassus operator
 (the redundant contacts of a bearing's two rings: rank 43-48 of 52-64 rows on ``c60-trip``,

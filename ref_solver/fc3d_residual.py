@@ -101,15 +101,41 @@ def roundoff_floor(W_abs, r: np.ndarray, u: np.ndarray, q: np.ndarray, mu: np.nd
     use_max : bool
         The normalisation of the residual it is compared with (as :func:`normalised`).
     """
-    m = q.size
-    eps = np.finfo(np.float64).eps
-    gamma = (m + 1) * eps / (1.0 - (m + 1) * eps)
     velocity_error = np.asarray(W_abs @ np.abs(r)).ravel() + np.abs(q)
-    amplification = 1.0 + (float(mu.max()) if mu.size else 0.0)
-    norm_r = math.sqrt(r.dot(r))
-    bound = amplification * gamma * math.sqrt(velocity_error.dot(velocity_error)) \
-        + 2.0 * eps * norm_r
-    return normalised(bound, math.sqrt(q.dot(q)), norm_r, math.sqrt(u.dot(u)), use_max)
+    return floor_of_velocity_error(math.sqrt(velocity_error.dot(velocity_error)), r, u, q, mu,
+                                   use_max)
+
+
+@njit(cache=True)
+def floor_of_velocity_error(velocity_error: float, r: np.ndarray, u: np.ndarray,
+                            q: np.ndarray, mu: np.ndarray, use_max: bool) -> float:
+    """The bound of :func:`roundoff_floor` from the 2-norm ``velocity_error`` of
+    |W| |r| + |q| (m,): the one formula of the sparse, dense and CSR floors."""
+    m = q.size
+    eps = 2.220446049250313e-16
+    gamma = (m + 1) * eps / (1.0 - (m + 1) * eps)
+    largest_mu = 0.0
+    for i in range(mu.size):
+        largest_mu = max(largest_mu, mu[i])
+    norm_r = math.sqrt(np.dot(r, r))
+    bound = (1.0 + largest_mu) * gamma * velocity_error + 2.0 * eps * norm_r
+    return normalised(bound, math.sqrt(np.dot(q, q)), norm_r, math.sqrt(np.dot(u, u)), use_max)
+
+
+@njit(cache=True)
+def roundoff_floor_csr(indptr: np.ndarray, indices: np.ndarray, data: np.ndarray,
+                       r: np.ndarray, u: np.ndarray, q: np.ndarray, mu: np.ndarray,
+                       use_max: bool) -> float:
+    """:func:`roundoff_floor` for W in CSR arrays (indptr (m + 1,), indices, data), without
+    forming |W|."""
+    total = 0.0
+    for row in range(q.size):
+        acc = 0.0
+        for k in range(indptr[row], indptr[row + 1]):
+            acc += abs(data[k]) * abs(r[indices[k]])
+        acc += abs(q[row])
+        total += acc * acc
+    return floor_of_velocity_error(math.sqrt(total), r, u, q, mu, use_max)
 
 
 @njit(cache=True)

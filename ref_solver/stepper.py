@@ -55,7 +55,12 @@ from clearbench.ref_solver.constraints import (
     delassus,
     row_values,
 )
-from clearbench.ref_solver.contact_problem import ContactProblem, SolverOptions, SolverStatus
+from clearbench.ref_solver.contact_problem import (
+    ContactProblem,
+    SolverOptions,
+    SolverResult,
+    SolverStatus,
+)
 from clearbench.ref_solver.fc3d_proximal import DEFAULT_RELATIVE_WEIGHT, proximal_newton_dense
 from clearbench.ref_solver.fc3d_solve import solve_contact_problem
 from clearbench.ref_solver.forces import (
@@ -76,6 +81,10 @@ from clearbench.ref_solver.projection_kernel import (
 from clearbench.ref_solver.step_kernels import free_velocity, velocity_problem
 from clearbench.ref_solver.system import MultibodySystem, State
 from clearbench.scenarios.geometry import MAX_CONTACTS_PER_PAIR
+
+#: The hybrid chain's proximal-point attempt among its (options, start) attempts
+#: (``MoreauJeanStepper._solve``).
+_PROXIMAL = object()
 
 
 @dataclass(frozen=True)
@@ -123,11 +132,11 @@ class StepperSettings:
         Most impacts localised within one step (>= 1); later ones in the step are taken by the
         classic scheme.
     proximal_rescue : float
-        > 0: when every attempt of the ``hybrid`` chain fails, a last one by proximal-point
-        Newton with the weight rho = ``proximal_rescue`` x the largest diagonal entry of W
-        (:mod:`.fc3d_proximal`), kept if it converges or ends below the best residual; default
-        :data:`.fc3d_proximal.DEFAULT_RELATIVE_WEIGHT` (1e-8). 0: no such attempt (the chain
-        before the rescue).
+        > 0: an attempt of the ``hybrid`` chain by proximal-point Newton from the warm start,
+        after its Newton attempts (from NSGS's end, the warm start and zero) failed
+        (:meth:`MoreauJeanStepper._solve`), with the weight rho = ``proximal_rescue`` x the
+        largest diagonal entry of W (:mod:`.fc3d_proximal`); default
+        :data:`.fc3d_proximal.DEFAULT_RELATIVE_WEIGHT` (1e-8). 0: no such attempt.
     """
 
     time_step: float
@@ -522,8 +531,12 @@ class MoreauJeanStepper:
         not converged, semismooth Newton from where NSGS stopped, then Newton with the
         least-norm direction from there (redundant bearing rings: it converges where the
         regularised direction crawls, 7 of the 11 failed chains of c60-trip's first 6 ms), then
-        Newton from the warm start, then from zero, then NSGS to its full cap from zero and
-        from where it stopped, keeping the first that converges (else the smallest residual);
+        Newton from the warm start, then from zero, then proximal-point Newton from the warm
+        start (weight ``proximal_rescue``, 0: skipped), then NSGS to its full cap from zero and
+        from where it stopped, keeping the first that converges (else the smallest residual).
+        The proximal attempt comes before the two NSGS attempts because on the C-60's
+        rank-deficient problems they fail where it converges, after 20,000 sweeps
+        (docs/reference-solver-speed.md);
         after a step that needed Newton, the Newton that converged is tried first from the
         warm start. Every attempt runs to its cap: stopping
         the attempts early when their rate of progress could not reach the tolerance
@@ -562,24 +575,26 @@ class MoreauJeanStepper:
         if first is None or nsgs_first.residual < best.residual:
             best = nsgs_first
         attempts = ((newton, nsgs_first.r), (least_norm, nsgs_first.r), (newton, r0),
-                    (newton, None), (nsgs, None), (nsgs, nsgs_first.r))
+                    (newton, None), (_PROXIMAL, r0), (nsgs, None), (nsgs, nsgs_first.r))
         for options, start in attempts:
-            attempt = solve_contact_problem(problem, options, r0=start)
+            if options is _PROXIMAL:
+                if cfg.proximal_rescue <= 0.0:
+                    continue
+                attempt = self._proximal(problem, start)
+            else:
+                attempt = solve_contact_problem(problem, options, r0=start)
             iterations += attempt.iterations
             if attempt.converged or attempt.residual < best.residual:
                 best = attempt
             if attempt.converged:
-                self._newton_first = options if options.method == "newton" else None
+                self._newton_first = (options if options is not _PROXIMAL
+                                      and options.method == "newton" else None)
                 break
-        if not best.converged and cfg.proximal_rescue > 0.0:
-            best = self._proximal_rescue(problem, r0, best)
-            iterations += best.iterations
         return replace(best, iterations=iterations)
 
-    def _proximal_rescue(self, problem: ContactProblem, r0: np.ndarray | None, best):
-        """The hybrid chain's last attempt (:func:`fc3d_proximal.proximal_newton_dense`) from
-        the warm start: its result if it converged or ended below ``best``'s residual (its
-        ``iterations`` its own), else ``best`` with 0 iterations."""
+    def _proximal(self, problem: ContactProblem, r0: np.ndarray | None) -> SolverResult:
+        """The hybrid chain's proximal-point attempt (:func:`fc3d_proximal.proximal_newton_dense`,
+        weight ``proximal_rescue``) from the warm start ``r0`` (zero when None)."""
         solver = self.settings.solver
         cap = self._solver_options[1].max_iterations  # the chain's Newton attempts' cap
         W = problem.W.toarray() if hasattr(problem.W, "toarray") else np.asarray(problem.W)
@@ -590,13 +605,12 @@ class MoreauJeanStepper:
             np.bool_(solver.use_max_normalisation), np.int64(cap),
             np.bool_(solver.roundoff_floor), float(solver.local_tolerance),
             np.int64(solver.local_max_iterations), np.empty(cap))
-        if not (converged or residual < best.residual):
-            return replace(best, iterations=0)
-        return replace(best, r=r, u=u, iterations=int(iterations), residual=float(residual),
-                       residual_q=residual_q, residual_max=residual_max,
-                       converged=bool(converged),
-                       status=SolverStatus.CONVERGED if converged else best.status,
-                       method="proximal newton", message="")
+        return SolverResult(
+            r=r, u=u, iterations=int(iterations), residual=float(residual),
+            residual_q=float(residual_q), residual_max=float(residual_max),
+            converged=bool(converged),
+            status=SolverStatus.CONVERGED if converged else SolverStatus.MAX_ITERATIONS,
+            method="proximal newton")
 
     def _candidates(self, x, rotation):
         """(gap, point_a, point_b, frame, count) of every pair at (x, rotation)."""

@@ -11,6 +11,9 @@ import math
 import numpy as np
 import pytest
 
+from clearbench.adapters.base import RunSettings
+from clearbench.adapters.reference.build import build
+from clearbench.adapters.reference.engine import create
 from clearbench.ref_solver import (
     ContactProblem,
     SolverOptions,
@@ -18,8 +21,12 @@ from clearbench.ref_solver import (
     natural_map_residual,
     solve_contact_problem,
 )
-from clearbench.ref_solver.contact_problem import Normalisation
+from clearbench.ref_solver.compiled import contact_solve
+from clearbench.ref_solver.compiled.system_arrays import compile_system
+from clearbench.ref_solver.contact_problem import Normalisation, _dense_to_csr
+from clearbench.ref_solver.dense_kernels import bilateral_operator_dense
 from clearbench.ref_solver.fc3d_residual import hopeless, roundoff_floor
+from clearbench.scenarios.library import get_scene
 
 
 def _sticking_problem(seed: int, condition: float):
@@ -62,8 +69,8 @@ def test_the_exact_solution_passes_the_roundoff_floor(condition):
 
 @pytest.mark.parametrize("method", ["nsgs", "newton"])
 def test_an_unreachable_tolerance_is_met_at_round_off_only_when_asked(method):
-    # NSGS tests the floor when its sweeps run out (Newton at every iteration): the cap
-    # leaves it time to reach round-off on this well-conditioned problem
+    # NSGS tests the floor at every residual check, Newton at every iteration: the cap leaves
+    # both time to reach round-off on this well-conditioned problem
     problem, _ = _sticking_problem(7, 10.0)
     impossible = SolverOptions(method=method, tolerance=1e-300, max_iterations=3000)
     plain = solve_contact_problem(problem, impossible)
@@ -75,6 +82,39 @@ def test_an_unreachable_tolerance_is_met_at_round_off_only_when_asked(method):
     floor = roundoff_floor(np.abs(problem.W), floored.r, floored.u, problem.q, problem.mu,
                            True)
     assert 1e-300 < floored.residual <= floor
+
+
+def test_nsgs_stops_at_the_first_sweep_within_its_floor():
+    # The C-60's hybrid chain at 4 us: NSGS's warm start is already at its round-off floor,
+    # 2e-12 against a tolerance of 1e-12, and sweeping on to the cap (100) changed nothing but
+    # the cost. With the floor tested at every check, NSGS stops at the first sweep whose
+    # residual is within it: one sweep fewer is still above it.
+    problem, _ = _sticking_problem(7, 10.0)
+    scene = get_scene("pendulum")  # any scene: only the solver settings are read
+    stepper = build(scene, create("default").run_settings(scene, RunSettings()),
+                    python_step=False).stepper
+    floored_options = dataclasses.replace(stepper.settings.solver, method="nsgs",
+                                          tolerance=1e-300, max_iterations=3000,
+                                          roundoff_floor=True)
+    floored = solve_contact_problem(problem, floored_options)
+    assert floored.converged and "round-off" in floored.message
+    assert 1 < floored.iterations < floored_options.max_iterations
+    earlier = solve_contact_problem(problem, dataclasses.replace(
+        floored_options, max_iterations=floored.iterations - 1))
+    assert not earlier.converged
+    # The compiled loop's NSGS (ref_solver.compiled.contact_solve) stops at the same sweep
+    # with the same impulses to round-off: one kernel decides for both loops, which build W's
+    # CSR arrays and the bilateral block's inverse by different routines. The bound: a few
+    # hundred eps of |r| for this problem of 61 rows and condition 10 (m eps cond = 1.4e-13).
+    _, cfg = compile_system(stepper)
+    cfg = cfg._replace(tolerance=1e-300, max_iterations=3000, roundoff_floor=True)
+    W = np.ascontiguousarray(problem.W)
+    nb = np.int64(problem.n_bilateral)
+    r, sweeps, _, converged = contact_solve._nsgs(
+        _dense_to_csr(W), problem.q, problem.mu, nb, bilateral_operator_dense(W, nb),
+        np.zeros(problem.q.size), 3000, cfg, np.empty(3000))
+    assert converged and sweeps == floored.iterations
+    assert np.abs(r - floored.r).max() <= 1e-12 * np.abs(floored.r).max()
 
 
 def test_hopeless_extrapolates_the_mean_rate():

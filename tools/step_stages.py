@@ -2,6 +2,7 @@
 timed with clocks around them (numba ``objmode``, about a microsecond each) over real steps.
 
     .venv/bin/python -m tools.step_stages c60-on 500 300   # 500 steps after 300 Python steps
+    .venv/bin/python -m tools.step_stages c60-on 300 20 --dt 0.016   # at 16 us
 
 The copy of ``single_step`` below is the same sequence of kernels (free velocity, candidates,
 then rounds of velocity stage, projection and the closing test until no contact closes); it
@@ -117,9 +118,11 @@ def main() -> None:
     parser.add_argument("scene")
     parser.add_argument("steps", type=int, help="steps timed")
     parser.add_argument("skip", type=int, help="steps taken first by the Python step")
+    parser.add_argument("--dt", type=float, default=None,
+                        help="time step [the scene's time unit]; default the scene's")
     args = parser.parse_args()
     scene = get_scene(args.scene)
-    model = build(scene, create("default").run_settings(scene, RunSettings()))
+    model = build(scene, create("default").run_settings(scene, RunSettings(time_step=args.dt)))
     stepper, state = model.stepper, model.state
     for _ in range(args.skip):
         state = stepper.step(state).state

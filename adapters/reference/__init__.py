@@ -35,8 +35,9 @@ HARNESS_DEFAULTS = HarnessDefaults(
     ),
     rigid_contacts=True,
     numba=True,
-    c60_ladders={"demo": {C60_ON: {"default": (1e-3, 4e-3)}, C60_TRIP: {"default": (1e-3,)}},
-                 "full": both_c60_scenes({"default": (5e-4, 1e-3, 2e-3, 4e-3)})},
+    c60_ladders={"demo": {C60_ON: {"default": (1e-3, 4e-3, 8e-3, 16e-3)},
+                          C60_TRIP: {"default": (1e-3,)}},
+                 "full": both_c60_scenes({"default": (5e-4, 1e-3, 2e-3, 4e-3, 8e-3, 16e-3)})},
     colour="#000000",
 )
 

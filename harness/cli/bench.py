@@ -58,6 +58,7 @@ class Benchmark:
 def bench_reference(args: argparse.Namespace) -> int:
     if args.against:
         return bench_against.run_against(args)
+    bench_against.refuse_without_baseline(args)
     print("Reference engine, wall time of stepping (best of 3, after a warm-up that compiles)")
     print(f"{'scene':<20} {'steps':>6} {'active contacts':>16} {'us/step':>9} "
           f"{'us/contact/iteration':>21}")
@@ -71,6 +72,7 @@ def bench_reference(args: argparse.Namespace) -> int:
 def bench_c60(args: argparse.Namespace) -> int:
     if args.against:
         return bench_against.run_against(args)
+    bench_against.refuse_without_baseline(args)
     print("C-60 full runs with the reference engine, one core (after a warm-up that compiles);")
     print("the paper quotes 810 s per run with Siconos; the target here is 10 s per c60-trip.")
     print(f"{'scene':<9} {'preset':<8} {'steps':>6} {'run [s]':>8} {'ms/step':>8} "

@@ -30,7 +30,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="--against: simulated time of each run (scene units; default the "
                         "benchmark's)")
     parser.add_argument("--presets", nargs="+", help="--against: reference presets")
+    parser.add_argument("--dt", nargs="+", type=float, metavar="DT",
+                        help="--against: run each case at each of these time steps (scene "
+                        "time unit, e.g. ms for the C-60; default the scene's)")
     parser.add_argument("--scenes", nargs="+", help="--against: only these scenes")
+
+
+def refuse_without_baseline(args: argparse.Namespace) -> None:
+    """A UserError naming the first ``--against``-only flag given without ``--against`` (it
+    would otherwise be ignored)."""
+    for flag in ("dt", "presets", "scenes", "horizon"):
+        if getattr(args, flag, None) is not None:
+            raise UserError(f"--{flag} {getattr(args, flag)} applies only with --against REV")
 
 
 def _checked_baseline(args: argparse.Namespace) -> str:
@@ -42,29 +53,34 @@ def _checked_baseline(args: argparse.Namespace) -> str:
         raise UserError(str(error)) from error
     if args.repeat < 1:
         raise UserError(f"--repeat must be >= 1, got {args.repeat}")
+    for step in getattr(args, "dt", None) or ():
+        if not step > 0.0:
+            raise UserError(f"--dt must be > 0 (a time step in the scene's time unit), got {step}")
     return commit
 
 
 def run_against(args: argparse.Namespace) -> int:
     commit = _checked_baseline(args)
     presets = args.presets or DEFAULT_PRESETS[args.benchmark]
-    cases = [Case(scene, preset, args.horizon or horizon, parameters)
+    cases = [Case(scene, preset, args.horizon or horizon, parameters, step)
              for preset in presets for scene, parameters, horizon in CASES[args.benchmark]
-             if not args.scenes or scene in args.scenes]
+             if not args.scenes or scene in args.scenes for step in args.dt or (None,)]
     print(f"Reference engine, baseline {args.against} ({commit[:10]}) and this revision, "
           f"alternately in one session, {args.repeat} run(s) of each on each side, best kept "
           "(stepping wall time after a warm-up that compiles)")
-    print(f"{'scene':<19} {'preset':<8} {'steps':>6} {'base [s]':>9} {'this [s]':>9} "
+    print(f"{'scene':<19} {'preset':<8} {'dt':>7} {'steps':>6} {'base [s]':>9} {'this [s]':>9} "
           f"{'speed-up':>8} {'base us/st':>10} {'this us/st':>10} {'unconv b/t':>11} "
           f"{'iter/step b/t':>14}")
 
     def report(pair) -> None:
+        step = "scene's" if pair.case.time_step is None else f"{pair.case.time_step:g}"
         if pair.error:
-            print(f"{pair.case.scene:<19} {pair.case.preset:<8} {pair.error}", flush=True)
+            print(f"{pair.case.scene:<19} {pair.case.preset:<8} {step:>7} {pair.error}",
+                  flush=True)
             return
         b, c = pair.best_baseline, pair.best_current
         steps = c["steps"]
-        print(f"{pair.case.scene:<19} {pair.case.preset:<8} {steps:>6} "
+        print(f"{pair.case.scene:<19} {pair.case.preset:<8} {step:>7} {steps:>6} "
               f"{b['stepping_seconds']:>9.2f} {c['stepping_seconds']:>9.2f} "
               f"{pair.speedup:>8.2f} {1e6 * b['stepping_seconds'] / b['steps']:>10.1f} "
               f"{1e6 * c['stepping_seconds'] / steps:>10.1f} "

@@ -33,17 +33,19 @@ WORKER = Path(__file__).with_name("against_worker.py")
 
 @dataclass(frozen=True)
 class Case:
-    """One benchmark case: a scene (with factory parameters), a preset and a horizon [scene
-    time unit; None: the scene's]."""
+    """One benchmark case: a scene (with factory parameters), a preset, a horizon and a time
+    step [scene time unit; None: the scene's]."""
 
     scene: str
     preset: str = "default"
     horizon: float | None = None
     parameters: dict = field(default_factory=dict)
+    time_step: float | None = None
 
     def request(self) -> str:
         return json.dumps({"scene": self.scene, "parameters": self.parameters,
-                           "preset": self.preset, "horizon": self.horizon}) + "\n"
+                           "preset": self.preset, "horizon": self.horizon,
+                           "time_step": self.time_step}) + "\n"
 
 
 @dataclass(frozen=True)

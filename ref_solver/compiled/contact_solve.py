@@ -15,8 +15,9 @@ import numpy as np
 from numba import njit
 
 from clearbench.ref_solver.contact_problem import _dense_to_csr
-from clearbench.ref_solver.dense_kernels import bilateral_operator_dense, roundoff_floor_dense
+from clearbench.ref_solver.dense_kernels import bilateral_operator_dense
 from clearbench.ref_solver.fc3d_newton_dense import CONVERGED, ROUNDOFF, newton_dense_kernel
+from clearbench.ref_solver.fc3d_nsgs import ROUNDOFF_CODE as NSGS_ROUNDOFF
 from clearbench.ref_solver.fc3d_nsgs import nsgs_kernel
 from clearbench.ref_solver.fc3d_proximal import proximal_newton_dense
 
@@ -35,21 +36,20 @@ NO_STALL = np.int64(0)
 
 
 @njit(cache=True)
-def _nsgs(w, csr, q, mu, n_bilateral, operator, r0, max_sweeps, cfg, history):
+def _nsgs(csr, q, mu, n_bilateral, operator, r0, max_sweeps, cfg, history):
     """NSGS from ``r0`` (m,) (not modified), as :func:`fc3d_nsgs.solve_nsgs`: (r (m,), sweeps,
-    residual, converged); a residual above the tolerance but under its round-off floor counts
-    as converged when ``cfg.roundoff_floor``."""
+    residual, converged); a residual above the tolerance but under its round-off floor at a
+    check counts as converged when ``cfg.roundoff_floor``."""
     r = r0.copy()
     u = np.empty(q.size)
     data, indices, indptr = csr
     code, sweeps, residual_q, residual_max, _, _ = nsgs_kernel(
         indptr, indices, data, q, mu, n_bilateral, operator, r, u, cfg.local_kind,
         cfg.tolerance, cfg.use_max, np.int64(max_sweeps), cfg.local_tolerance,
-        cfg.local_max_iterations, cfg.check_interval, history, NO_STALL, NO_STALL)
+        cfg.local_max_iterations, cfg.check_interval, history, NO_STALL, NO_STALL,
+        cfg.roundoff_floor)
     residual = residual_max if cfg.use_max else residual_q
-    converged = code == 0
-    if (code == 1 or code == 2) and cfg.roundoff_floor:
-        converged = residual <= roundoff_floor_dense(w, r, u, q, mu, cfg.use_max)
+    converged = code == 0 or code == NSGS_ROUNDOFF
     return r, sweeps, residual, converged
 
 
@@ -89,7 +89,7 @@ def solve(w, q, mu, n_bilateral, r0, cfg, newton_first, history):
     csr = _dense_to_csr(w)
     operator = bilateral_operator_dense(w, n_bilateral)
     if cfg.method == METHOD_NSGS:
-        return _nsgs(w, csr, q, mu, n_bilateral, operator, r0, cfg.max_iterations, cfg,
+        return _nsgs(csr, q, mu, n_bilateral, operator, r0, cfg.max_iterations, cfg,
                      history)
     iterations = 0
     first = newton_first[0]
@@ -101,7 +101,7 @@ def solve(w, q, mu, n_bilateral, r0, cfg, newton_first, history):
         if best_ok:
             return best_r, its, best_residual, best_ok
         iterations = its
-    r_nsgs, its, res_nsgs, ok_nsgs = _nsgs(w, csr, q, mu, n_bilateral, operator, r0,
+    r_nsgs, its, res_nsgs, ok_nsgs = _nsgs(csr, q, mu, n_bilateral, operator, r0,
                                            cfg.hybrid_sweeps, cfg, history)
     iterations += its
     if ok_nsgs:
@@ -109,14 +109,22 @@ def solve(w, q, mu, n_bilateral, r0, cfg, newton_first, history):
         return r_nsgs, iterations, res_nsgs, ok_nsgs
     if first == NO_NEWTON_FIRST or res_nsgs < best_residual:
         best_r, best_residual, best_ok = r_nsgs, res_nsgs, ok_nsgs
-    # The attempts of the chain, in order: (kind 0 regularised Newton, 1 least-norm Newton,
-    # 2 NSGS to its full cap; start 0 NSGS's end, 1 the warm start, 2 zero).
-    kinds = (0, 1, 0, 0, 2, 2)
-    starts = (0, 0, 1, 2, 2, 0)
-    for a in range(6):
+    # The attempts of the chain, in order (``MoreauJeanStepper._solve``): kind 0 regularised
+    # Newton, 1 least-norm Newton, 2 NSGS to its full cap, 3 proximal-point Newton (skipped
+    # when ``cfg.proximal_rescue`` is 0); start 0 NSGS's end, 1 the warm start, 2 zero.
+    kinds = (0, 1, 0, 0, 3, 2, 2)
+    starts = (0, 0, 1, 2, 1, 2, 0)
+    for a in range(7):
         start = r_nsgs if starts[a] == 0 else (r0 if starts[a] == 1 else zeros)
-        if kinds[a] == 2:
-            r, its, res, ok = _nsgs(w, csr, q, mu, n_bilateral, operator, start,
+        if kinds[a] == 3:
+            if cfg.proximal_rescue <= 0.0:
+                continue
+            r, _, its, _, _, res, ok = proximal_newton_dense(
+                w, q, mu, n_bilateral, start, cfg.proximal_rescue, cfg.tolerance, cfg.use_max,
+                np.int64(HYBRID_NEWTON_ITERATIONS), cfg.roundoff_floor, cfg.local_tolerance,
+                cfg.local_max_iterations, history)
+        elif kinds[a] == 2:
+            r, its, res, ok = _nsgs(csr, q, mu, n_bilateral, operator, start,
                                     cfg.max_iterations, cfg, history)
         else:
             r, its, res, ok = _newton(w, q, mu, n_bilateral, start, HYBRID_NEWTON_ITERATIONS,
@@ -132,12 +140,4 @@ def solve(w, q, mu, n_bilateral, r0, cfg, newton_first, history):
             else:
                 newton_first[0] = NO_NEWTON_FIRST
             break
-    if not best_ok and cfg.proximal_rescue > 0.0:
-        r, _, its, _, _, res, ok = proximal_newton_dense(
-            w, q, mu, n_bilateral, r0, cfg.proximal_rescue, cfg.tolerance, cfg.use_max,
-            np.int64(HYBRID_NEWTON_ITERATIONS), cfg.roundoff_floor, cfg.local_tolerance,
-            cfg.local_max_iterations, history)
-        iterations += its
-        if ok or res < best_residual:
-            best_r, best_residual, best_ok = r, res, ok
     return best_r, iterations, best_residual, best_ok
