@@ -21,8 +21,8 @@ step instead of over the whole step, which takes the bouncing-ball apex errors a
 from 8e-3 to 2e-5),
 ``roundoff_floor``, ``step_loop`` (``auto``, ``python`` or ``compiled``: :mod:`.run`) and
 ``proximal_rescue`` (default 1e-8: an attempt of the hybrid chain by proximal-point Newton
-when its Newton attempts (from NSGS's end, the warm start and zero) failed, its weight relative to W's largest diagonal entry,
-ref_solver/fc3d_proximal.py; 0: off); see
+when its Newton attempts (from NSGS's end, the warm start and zero) failed, its weight
+relative to W's largest diagonal entry, ref_solver/fc3d_proximal.py; 0: off); see
 :class:`~clearbench.ref_solver.stepper.StepperSettings`.
 """
 
