@@ -5,7 +5,9 @@ drivers and active contacts at the current configuration; contacts that carry an
 equalities, the others unilateral; the multipliers of the mixed LCP by the active-set method
 of :func:`projection.solve_projection`; the correction dq = Mp^-1 H^T delta halved until the
 largest violation decreases), with the candidates, the rows, the Delassus operator, the
-least-squares solves and the orientation update in one numba call per projection.
+least-squares solves and the orientation update in one numba call per projection. The
+corrections of one projection together move no point by more than :data:`PROJECTION_REACH`
+times the violation it set out to remove.
 
 The system's arrays travel as one tuple, :func:`geometry_arrays` (the order is the argument
 order of :func:`constraints.contact_candidates` and :func:`constraints.bilateral_rows`).
@@ -33,6 +35,23 @@ from clearbench.scenarios.geometry import MAX_CONTACTS_PER_PAIR
 MAX_PROJECTION_HALVINGS = 8
 #: Active-set iterations of the multipliers' mixed LCP.
 MAX_ACTIVE_SET_ITERATIONS = 50
+#: Largest displacement of a body's points over one projection (the sum of its accepted
+#: corrections), as a multiple of the largest violation it set out to remove
+#: (:func:`correction_budget`). A Gauss–Newton correction is the least motion (in the
+#: projection's metric) that removes the linearised violations; it is far larger than them only
+#: where the rows are nearly dependent and their values not compatible (redundant contacts of
+#: clearance joints closed with impulse together with a stop's contacts), and there it follows
+#: a direction the linearisation does not describe: the correction that moved the C-60's hook by
+#: 13.9 mm and turned it by 2.07 rad in one step to remove a violation of 2.1 um (``c60-trip``,
+#: variant ``paper-table-4``, 16 us, step 706) met the active rows again at other candidates,
+#: and the run went on with the mechanism taken apart. The C-60's projections at 1 us move
+#: points by far less (docs/reference-solver.md, "The projection's bound", measures them).
+PROJECTION_REACH = 1000.0
+#: A projection moving points by at most this fraction of the scene's length scale is never
+#: bounded: near convergence (violations of 1e-12 mm) the corrections of redundant rows read
+#: 1e-7 mm on the C-60, the round-off of the rows' directions, not a departure from the
+#: linearisation.
+CORRECTION_FLOOR = 1e-6
 
 
 def geometry_arrays(system) -> tuple:
@@ -244,14 +263,41 @@ def active_set_multipliers(W, b, n_equal, tolerance, max_iterations):
 
 
 @njit(cache=True)
+def correction_budget(worst, length_scale):
+    """Largest displacement [L] of a body's points over a projection that set out to remove a
+    largest violation ``worst`` [L]: :data:`PROJECTION_REACH` times it, plus
+    :data:`CORRECTION_FLOOR` times the scene's ``length_scale`` [L]."""
+    return PROJECTION_REACH * worst + CORRECTION_FLOOR * length_scale
+
+
+@njit(cache=True)
+def correction_size(delta, length_scale):
+    """Largest displacement [L] of a body's points under the correction ``delta`` (nb, 6)
+    (translations [L], rotation vectors [rad]): |dx| + r |dtheta| over the bodies, with r the
+    scene's ``length_scale`` [L] (its largest feature, so at least the distance of any
+    constraint point from the body's centre of mass)."""
+    size = 0.0
+    for b in range(delta.shape[0]):
+        translation = math.sqrt(delta[b, 0] ** 2 + delta[b, 1] ** 2 + delta[b, 2] ** 2)
+        rotation = math.sqrt(delta[b, 3] ** 2 + delta[b, 4] ** 2 + delta[b, 5] ** 2)
+        size = max(size, translation + length_scale * rotation)
+    return size
+
+
+@njit(cache=True)
 def project(arrays, n_bilateral, t, x, p, active, closed, metric_inverse, cluster,
-            cluster_dofs, cluster_start, position_tolerance, max_iterations):
+            cluster_dofs, cluster_start, position_tolerance, max_iterations, length_scale):
     """Globalised Gauss–Newton projection of (x (nb, 3), p (nb, 4)) in place (see the module
-    docstring); returns (iterations, largest remaining violation [L], converged)."""
+    docstring); its corrections together move no body's points by more than the budget of
+    the largest violation at the start (:func:`correction_budget`, ``length_scale`` [L]): a
+    correction beyond what is left of it is scaled to it, and the projection stops
+    unconverged when it is spent. Returns (iterations, largest remaining violation [L],
+    converged)."""
     fixed = arrays[0]
     nb = x.shape[0]
     row_body, row_coef, values, n_equal, worst = projection_rows(
         arrays, n_bilateral, t, x, p, active, closed)
+    budget = correction_budget(worst, length_scale)
     for iteration in range(max_iterations + 1):
         if worst <= position_tolerance or values.size == 0:
             return iteration, worst, True
@@ -269,6 +315,10 @@ def project(arrays, n_bilateral, t, x, p, active, closed, metric_inverse, cluste
                 for j in range(m):
                     acc += y[6 * b + i, j] * multipliers[j]
                 delta[b, i] = acc
+        size = correction_size(delta, length_scale)
+        if size > budget:
+            delta *= budget / size
+            size = budget
         x0 = x.copy()
         p0 = p.copy()
         improved = False
@@ -280,9 +330,13 @@ def project(arrays, n_bilateral, t, x, p, active, closed, metric_inverse, cluste
                 improved = True
                 break
             delta *= 0.5
+            size *= 0.5
         if not improved:
             x[:] = x0
             p[:] = p0
             return iteration + 1, worst, False
         row_body, row_coef, values, n_equal, worst = trial
+        budget -= size
+        if budget <= 0.0 and worst > position_tolerance:
+            return iteration + 1, worst, False
     return max_iterations, worst, False

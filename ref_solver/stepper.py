@@ -75,6 +75,8 @@ from clearbench.ref_solver.projection_kernel import (
     candidates,
     closed_gap_limit,
     closed_gap_slack,
+    correction_budget,
+    correction_size,
     geometry_arrays,
     project,
 )
@@ -110,7 +112,8 @@ class StepperSettings:
         of the step [L].
     length_scale : float
         Characteristic length [L] (the scene's largest): finite-difference steps of the
-        spring stiffness, and the round-off of gaps (``projection_kernel.closed_gap_slack``).
+        spring stiffness, the round-off of gaps (``projection_kernel.closed_gap_slack``) and
+        the bound of the projection's corrections (``projection_kernel.correction_budget``).
     method : str
         ``nsgs``, ``newton`` or ``hybrid`` (NSGS for at most ``hybrid_sweeps`` sweeps, then
         Newton from where it stopped).
@@ -799,7 +802,7 @@ class MoreauJeanStepper:
         iterations, worst, converged = project(
             self.geometry, self.n_bilateral, state.t, state.x, state.p, active, closed,
             self.projection_inverse, *self.single_clusters, self.settings.position_tolerance,
-            self.settings.max_projection_iterations)
+            self.settings.max_projection_iterations, self.settings.length_scale)
         return int(iterations), float(worst), bool(converged)
 
     def _project_python(self, state: State, active, closed) -> tuple[int, float, bool]:
@@ -807,6 +810,7 @@ class MoreauJeanStepper:
         sys_ = self.system
         cfg = self.settings
         row_body, row_coef, values, n_equal, worst = self._violations(state, active, closed)
+        budget = correction_budget(worst, cfg.length_scale)
         for iteration in range(cfg.max_projection_iterations + 1):
             if worst <= cfg.position_tolerance or len(values) == 0:
                 return iteration, worst, True
@@ -817,6 +821,11 @@ class MoreauJeanStepper:
             # Contacts of the active set that are open keep a zero multiplier.
             solve = solve_projection(w, values, n_equal, 0.1 * cfg.position_tolerance)
             delta = (y @ solve.delta).reshape(-1, 6)
+            # Over the projection, the corrections move no point by more than the budget.
+            size = correction_size(delta, cfg.length_scale)
+            if size > budget:
+                delta *= budget / size
+                size = budget
             x0, p0 = state.x.copy(), state.p.copy()
             for _ in range(MAX_PROJECTION_HALVINGS + 1):
                 state.x[:] = x0 + delta[:, :3]
@@ -826,10 +835,14 @@ class MoreauJeanStepper:
                 if trial[4] < worst:
                     break
                 delta *= 0.5
+                size *= 0.5
             else:
                 state.x[:], state.p[:] = x0, p0
                 return iteration + 1, worst, False
             row_body, row_coef, values, n_equal, worst = trial
+            budget -= size
+            if budget <= 0.0 and worst > cfg.position_tolerance:
+                return iteration + 1, worst, False
         return cfg.max_projection_iterations, worst, False
 
 

@@ -148,7 +148,7 @@ def _projection_stage(s, cfg, t, x, p, active, closed):
     iterations, worst, converged = project(
         s.geometry, s.n_bilateral, t, x, p, active, closed, s.projection_inverse,
         s.single_cluster, s.single_dofs, s.single_start, cfg.position_tolerance,
-        cfg.max_projection_iterations)
+        cfg.max_projection_iterations, cfg.length_scale)
     if converged or not np.isfinite(closed).any():
         return iterations, worst, converged
     best_worst, best_x, best_p = worst, x.copy(), p.copy()
@@ -157,7 +157,7 @@ def _projection_stage(s, cfg, t, x, p, active, closed):
     more, worst, converged = project(
         s.geometry, s.n_bilateral, t, x, p, active, np.full_like(closed, -np.inf),
         s.projection_inverse, s.single_cluster, s.single_dofs, s.single_start,
-        cfg.position_tolerance, cfg.max_projection_iterations)
+        cfg.position_tolerance, cfg.max_projection_iterations, cfg.length_scale)
     iterations += more
     if not converged and best_worst < worst:
         worst = best_worst

@@ -77,6 +77,7 @@ class LoopSettings(NamedTuple):
     roundoff_floor: bool
     proximal_rescue: float          # StepperSettings.proximal_rescue (0: off)
     closed_gap_slack: float         # projection_kernel.closed_gap_slack [L]
+    length_scale: float             # StepperSettings.length_scale [L]
 
 
 def compile_system(stepper) -> tuple[CompiledSystem, LoopSettings]:
@@ -114,7 +115,8 @@ def compile_system(stepper) -> tuple[CompiledSystem, LoopSettings]:
         check_interval=int(solver.residual_check_interval),
         roundoff_floor=bool(solver.roundoff_floor),
         proximal_rescue=float(cfg.proximal_rescue),
-        closed_gap_slack=float(closed_gap_slack(cfg.position_tolerance, cfg.length_scale)))
+        closed_gap_slack=float(closed_gap_slack(cfg.position_tolerance, cfg.length_scale)),
+        length_scale=float(cfg.length_scale))
     return system, settings
 
 
