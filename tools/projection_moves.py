@@ -24,13 +24,9 @@ import numpy as np
 from clearbench.adapters.base import RunSettings
 from clearbench.adapters.reference.build import build
 from clearbench.adapters.reference.engine import create
+from clearbench.kernels.quaternion import quat_angular_distance_batch
 from clearbench.ref_solver.projection_kernel import CORRECTION_FLOOR, PROJECTION_REACH
 from clearbench.scenarios.library import get_scene
-
-
-def _turn(p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
-    """Rotation angle [rad] from unit quaternions p0 to p1, (nb, 4) each."""
-    return 2.0 * np.arccos(np.clip(np.abs(np.sum(p0 * p1, axis=1)), 0.0, 1.0))
 
 
 def observe(scene_name: str, variant: str | None, time_step: float, steps: int) -> list:
@@ -50,7 +46,7 @@ def observe(scene_name: str, variant: str | None, time_step: float, steps: int) 
         x0, p0 = stage_state.x.copy(), stage_state.p.copy()
         result = original(stage_state, active, impulses, closed)
         moves = (np.linalg.norm(stage_state.x - x0, axis=1)
-                 + length * _turn(p0, stage_state.p))
+                 + length * quat_angular_distance_batch(p0, stage_state.p))
         body = int(np.argmax(moves))
         seen.append((moves[body] / (violation + floor), current[0], violation, moves[body],
                      names[body]))
