@@ -17,7 +17,9 @@ One step of length h from state k (Section 2.4 of Akhadkar, Acary, Brogliato 201
    violation is below ``position_tolerance``.
 5. Activation stage: I <- I U {alpha : g_alpha(q_{k+1}) <= 0}; when I grew, the step is redone
    from state k (eq. 22). I starts as the contacts already closed at q_k (gap <= the activation
-   margin); without projection it starts as Moreau's prediction g + (h/2) u_N <= 0.
+   margin), or with ``activation="predicted"`` also those the free motion closes within the
+   step and those held from the previous step (:mod:`.activation`); without projection it
+   starts as Moreau's prediction g + (h/2) u_N <= 0.
 6. Impact localisation (``localise_impacts=True``, with the projection): the steps above apply
    an impact over the whole step. A ball approaching at speed v that crosses the ground at the
    fraction tau of the step ends it (position update with the mean of the pre- and post-impact
@@ -49,6 +51,13 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from clearbench.ref_solver.activation import (
+    RULE_GAP,
+    RULE_PREDICTED,
+    RULES,
+    activation_rule,
+    first_round,
+)
 from clearbench.ref_solver.constraints import (
     bilateral_rows,
     contact_rows,
@@ -110,6 +119,13 @@ class StepperSettings:
     activation_margin : float
         Contacts whose gap at the start of the step is below this are active from the start
         of the step [L].
+    activation : str
+        With the projection, the first activation round's rule (:mod:`.activation`): ``gap``
+        (the contacts closed at the step's start, the study's scheme) or ``predicted`` (also
+        those that the free motion closes within the step, and those that carried an impulse
+        in the previous step while open by at most ``activation_hold``).
+    activation_hold : float
+        The hold margin of the ``predicted`` rule [L] (>= 0).
     length_scale : float
         Characteristic length [L] (the scene's largest): finite-difference steps of the
         spring stiffness, the round-off of gaps (``projection_kernel.closed_gap_slack``) and
@@ -151,6 +167,8 @@ class StepperSettings:
     max_projection_iterations: int = 30
     max_activation_rounds: int = 20
     activation_margin: float = 1e-12
+    activation: str = "gap"
+    activation_hold: float = 0.0
     length_scale: float = 1.0
     method: str = "hybrid"
     hybrid_sweeps: int = 100
@@ -165,6 +183,11 @@ class StepperSettings:
             raise ValueError(f"time_step must be > 0, got {self.time_step!r}")
         if not 0.5 <= self.theta <= 1.0:
             raise ValueError(f"theta must be in [0.5, 1], got {self.theta!r}")
+        if self.activation not in RULES:
+            raise ValueError(f"activation must be one of {sorted(RULES)}, got "
+                             f"{self.activation!r}")
+        if not self.activation_hold >= 0.0:
+            raise ValueError(f"activation_hold must be >= 0, got {self.activation_hold!r}")
         if self.joint_law not in ("midpoint", "end"):
             raise ValueError(f"joint_law must be 'midpoint' or 'end', got {self.joint_law!r}")
         if not self.position_tolerance > 0.0:
@@ -441,12 +464,16 @@ class MoreauJeanStepper:
 
         # Contacts at q_k and their normal velocities.
         cand = self._candidates(state.x, rotation)
-        gap_k = cand[0]
-        if cfg.projection:
-            active = self._slots(cand, gap_k <= cfg.activation_margin)
-        else:
-            u_normal = self._normal_velocity(state, rotation, cand, nu)
-            active = self._slots(cand, gap_k + 0.5 * h * u_normal <= cfg.activation_margin)
+        rule = activation_rule(cfg)
+        u_start = u_free = np.zeros_like(cand[0])
+        if rule != RULE_GAP:
+            u_start = self._normal_velocity(state, rotation, cand, nu)
+        if rule == RULE_PREDICTED:
+            u_free = self._normal_velocity(state, rotation, cand, free)
+        active = self._slots(cand, first_round(
+            rule, cand[0], u_start, u_free, self.previous_impulse, h, theta,
+            cfg.activation_margin, cfg.activation_hold, sys_.pair_restitution,
+            cfg.restitution_threshold))
 
         totals = dict(iterations=0, projection_iterations=0)
         self._solver_seconds = 0.0

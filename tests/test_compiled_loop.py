@@ -50,11 +50,11 @@ def _supported(scene) -> bool:
     return choose_step_loop("auto", model.stepper).compiled
 
 
-def _compare(name: str) -> None:
+def _compare(name: str, options: dict | None = None) -> None:
     scene = get_scene(name)
     h = scene.time_step
-    runs = {loop: create("default").run(scene, RunSettings(horizon=STEPS * h,
-                                                           options={"step_loop": loop}))
+    runs = {loop: create("default").run(scene, RunSettings(
+                horizon=STEPS * h, options={**(options or {}), "step_loop": loop}))
             for loop in ("python", "compiled")}
     python, compiled = runs["python"], runs["compiled"]
     assert python.metadata["step_loop"] == "python"
@@ -117,6 +117,13 @@ def test_compiled_loop_agrees_with_python_step_on_every_supported_scene(name, re
     if not _supported(scene):
         pytest.skip("the compiled loop does not support this scene (see test_fallback)")
     _compare(name)
+
+
+@pytest.mark.parametrize("name", ["clearance-pendulum", "slider-crank", "box-grid", "c60-on"])
+def test_both_loops_apply_the_predicted_activation_alike(name):
+    # The first activation round's rule other than the default (ref_solver/activation.py), on
+    # scenes with clearance joints, ideal joints and resting contacts.
+    _compare(name, {"activation": "predicted"})
 
 
 def test_unsupported_scene_falls_back_with_its_reason():

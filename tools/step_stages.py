@@ -26,7 +26,13 @@ from clearbench.adapters.base import RunSettings
 from clearbench.adapters.reference.build import build
 from clearbench.adapters.reference.engine import create
 from clearbench.adapters.reference.run import _memory
-from clearbench.ref_solver.compiled.step import _projection_stage, _velocity_stage, valid_slots
+from clearbench.harness.cli.common import assignments
+from clearbench.ref_solver.compiled.step import (
+    _projection_stage,
+    _velocity_stage,
+    first_round_active,
+    valid_slots,
+)
 from clearbench.ref_solver.compiled.system_arrays import compile_system, history_length
 from clearbench.ref_solver.forces import remember_angles, rotation_matrices
 from clearbench.ref_solver.projection_kernel import candidates
@@ -67,7 +73,7 @@ def timed_steps(s, cfg, memory, t, x, p, v, omega, history, n, seconds, counts, 
         t1 = _now()
         seconds[0] += t1 - t0
         cand = candidates(s.geometry, x, rotation)
-        active = valid_slots(cand[4], cand[0] <= cfg.activation_margin)
+        active = first_round_active(s, cfg, x, rotation, cand, nu, free, memory[0])
         seconds[1] += _now() - t1
         rounds = 0
         while True:
@@ -120,9 +126,15 @@ def main() -> None:
     parser.add_argument("skip", type=int, help="steps taken first by the Python step")
     parser.add_argument("--dt", type=float, default=None,
                         help="time step [the scene's time unit]; default the scene's")
+    parser.add_argument("--option", action="append", default=[], metavar="NAME=VALUE",
+                        help="a reference option (as `clearbench run --option`)")
     args = parser.parse_args()
     scene = get_scene(args.scene)
-    model = build(scene, create("default").run_settings(scene, RunSettings(time_step=args.dt)))
+    engine = create("default")
+    options = assignments(args.option, "--option")
+    engine.check_options(options)
+    model = build(scene, engine.run_settings(scene, RunSettings(time_step=args.dt,
+                                                                options=options)))
     stepper, state = model.stepper, model.state
     for _ in range(args.skip):
         state = stepper.step(state).state

@@ -14,7 +14,11 @@ Presets (each a separate engine variant in results):
 Options (``RunSettings.options``) override: ``theta``, ``projection``, ``method``,
 ``tolerance``, ``max_iterations``, ``position_tolerance``, ``activation_margin`` (default
 1e-10 x the smallest feature: contacts open by less at a step's start are active from its
-start), ``restitution_threshold`` (default 2 |g| h: slower impacts are plastic),
+start), ``activation`` (``gap``, the study's rule, or ``predicted``: the first activation
+round also holds the contacts the free motion closes within the step and those that carried
+an impulse in the previous step while open by at most ``activation_hold``, default 1e-2 x the
+smallest feature; ref_solver/activation.py),
+``restitution_threshold`` (default 2 |g| h: slower impacts are plastic),
 ``joint_law`` (``midpoint`` or ``end``), ``localise_impacts`` (true or false; every preset
 with the projection has it on: an impact with e > 0 is applied at its crossing time within the
 step instead of over the whole step, which takes the bouncing-ball apex errors at h = 1e-3 s
@@ -34,6 +38,7 @@ import numpy as np
 
 from clearbench.adapters.base import RunSettings
 from clearbench.adapters.options import OptionTable, boolean, choice, integer, number
+from clearbench.ref_solver.activation import RULES as ACTIVATION_RULES
 from clearbench.ref_solver.contact_problem import METHODS, SolverOptions
 from clearbench.ref_solver.fc3d_proximal import DEFAULT_RELATIVE_WEIGHT
 from clearbench.ref_solver.stepper import StepperSettings
@@ -58,6 +63,8 @@ OPTIONS = OptionTable("reference", (
     integer("max_iterations", at_least=1),
     number("position_tolerance", above=0.0),
     number("activation_margin", above=0.0),
+    choice("activation", tuple(ACTIVATION_RULES)),
+    number("activation_hold", at_least=0.0),
     number("restitution_threshold", at_least=0.0),
     choice("joint_law", ("midpoint", "end")),
     boolean("localise_impacts"),
@@ -98,6 +105,10 @@ def stepper_settings(preset: str, scene: Scene, settings: RunSettings) -> Steppe
         # anything the metrics resolve, far above round-off of positions.
         position_tolerance=float(options.get("position_tolerance", 1e-10 * smallest)),
         activation_margin=float(options.get("activation_margin", 1e-10 * smallest)),
+        activation=str(options.get("activation", "gap")),
+        # 1e-2 of the smallest feature (1e-5 mm on the C-60): on c60-on at 1 us it holds the
+        # contacts that reopen by round-off and close again (docs/reference-solver-speed.md).
+        activation_hold=float(options.get("activation_hold", 1e-2 * smallest)),
         length_scale=largest,
         method=method,
         joint_law=str(options.get("joint_law", "midpoint")),

@@ -136,11 +136,15 @@ class StudyRuns:
         Run every run again once, even when the store holds it.
     campaign : str
         Recorded with each run (which command asked for it).
+    options : Mapping, optional
+        The engine's run options of every run (``clearbench run --option``), for instance a
+        scheme variant of the reference to validate (checked with the first run's spec).
     """
 
     def __init__(self, store: ResultsStore, runner: Runner | None = None,
                  engine: EngineChoice | str = "reference", timeout: float = DEFAULT_TIMEOUT,
-                 run_missing: bool = True, rerun: bool = False, campaign: str = "c60"):
+                 run_missing: bool = True, rerun: bool = False, campaign: str = "c60",
+                 options: Mapping | None = None):
         self.store = store
         self.runner = runner if runner is not None else Runner(store)
         self.engine = resolve_engine(engine) if isinstance(engine, str) else engine
@@ -148,6 +152,7 @@ class StudyRuns:
         self.run_missing = run_missing
         self.rerun = rerun
         self.campaign = campaign
+        self.options = dict(options or {})
         #: Store keys of the runs made by this object, and of those served from the store.
         self.made: list[str] = []
         self.reused: list[str] = []
@@ -158,6 +163,15 @@ class StudyRuns:
     def preset(self) -> str:
         return self.engine.preset
 
+    @property
+    def settings_label(self) -> str:
+        """The preset and the options of the runs, as a report names them
+        (``default`` or ``default; options activation=predicted``)."""
+        if not self.options:
+            return self.preset
+        given = ", ".join(f"{key}={value}" for key, value in sorted(self.options.items()))
+        return f"{self.preset}; options {given}"
+
     def spec(self, request: RunRequest) -> RunSpec:
         """The run spec of ``request`` (validated: an unknown scene or parameter raises
         :class:`~clearbench.harness.run.engine_choice.RunInputError`)."""
@@ -166,8 +180,8 @@ class StudyRuns:
         if identity not in self._specs:
             self._specs[identity] = make_run_spec(
                 request.scene_name, self.engine.label, scene_parameters=request.parameters,
-                record_every=request.record_every, timeout=self.timeout,
-                engine_choice=self.engine, campaign=self.campaign)
+                record_every=request.record_every, options=self.options,
+                timeout=self.timeout, engine_choice=self.engine, campaign=self.campaign)
         return self._specs[identity]
 
     def make(self, requests: Iterable[RunRequest]) -> None:

@@ -34,13 +34,14 @@ from clearbench.harness.cli.common import (
     UserError,
     add_engine_option,
     add_runner_options,
+    assignments,
     engine_modules,
     make_runner,
     open_store,
 )
 from clearbench.harness.measure.headline import format_value
 from clearbench.harness.report.page import write_report
-from clearbench.harness.run.engine_choice import RunInputError, resolve_engine
+from clearbench.harness.run.engine_choice import RunInputError, check_options, resolve_engine
 from clearbench.harness.studies.c60_comparison import PLAN_NAMES, c60_plan, plan_engines, plan_runs
 
 DEFAULT_REPORT = Path("reports/c60_validation.md")
@@ -133,6 +134,9 @@ def _add_run_options(parser, report: Path, what: str) -> None:
     """--out, --preset and the runner's options of the commands that run the C-60 studies."""
     parser.add_argument("--out", type=Path, default=report, help=f"{what} (default {report})")
     parser.add_argument("--preset", default="default", help="reference engine preset")
+    parser.add_argument("--option", action="append", default=[], metavar="KEY=VALUE",
+                        help="a reference engine option of every run (as `clearbench run "
+                             "--option`; repeatable), for instance a scheme variant")
     add_runner_options(parser, timeout=STUDY_TIMEOUT, engine_module=False)
 
 
@@ -142,8 +146,10 @@ def _study_runs(args: argparse.Namespace, campaign: str, run_missing: bool = Tru
     engine = resolve_engine(f"reference[{args.preset}]")
     store = open_store(args)
     runner = make_runner(args, store, total=2)   # a study makes several runs
+    options = assignments(args.option, "--option")
+    check_options(engine, options)
     return StudyRuns(store, runner, engine, timeout=args.timeout, run_missing=run_missing,
-                     rerun=args.rerun, campaign=campaign)
+                     rerun=args.rerun, campaign=campaign, options=options)
 
 
 def _print_made(runs: StudyRuns) -> None:
@@ -165,8 +171,8 @@ def run_validate(args: argparse.Namespace) -> int:
     for finding in report.findings:
         print(f"- {finding}")
     figures = write_figures(report, args.figures)
-    write_markdown(report, args.out, figures, runs.preset)
-    write_json(report, args.out.with_suffix(".json"), figures, runs.preset)
+    write_markdown(report, args.out, figures, runs.settings_label)
+    write_json(report, args.out.with_suffix(".json"), figures, runs.settings_label)
     print(f"report: {args.out} (and {args.out.with_suffix('.json')} for `clearbench report`)")
     for path in figures.values():
         print(f"figure: {path}")
@@ -192,7 +198,7 @@ def run_identify(args: argparse.Namespace) -> int:
     _print_made(runs)
     lines = identification.table_lines(study)
     print("\n".join(lines))
-    identification.write_markdown(study, args.out, runs.preset, identification.ON_HORIZON)
+    identification.write_markdown(study, args.out, runs.settings_label, identification.ON_HORIZON)
     identification.write_json(study, args.out.with_suffix(".json"))
     print(f"report: {args.out} (and {args.out.with_suffix('.json')})")
     return 0

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from clearbench.ref_solver.activation import RULE_GAP, first_round
 from clearbench.ref_solver.compiled.contact_solve import solve
 from clearbench.ref_solver.constraints import contact_rows, row_values
 from clearbench.ref_solver.forces import rotation_matrices
@@ -47,25 +48,43 @@ def _selected(mask):
 
 
 @njit(cache=True)
-def _normal_velocity(s, x, rotation, cand, nu):
-    """Normal velocity (npair, K) [L/T] of every candidate at twist ``nu`` (nb, 6)
-    (``MoreauJeanStepper._normal_velocity``; the contact rows alone: they do not depend on
-    the bilateral rows before them)."""
-    out = np.zeros_like(cand[0])
+def _normal_velocities(s, x, rotation, cand, nu, free):
+    """Normal velocities (npair, K) [L/T] of every candidate at the twists ``nu`` and ``free``
+    (nb, 6) (``MoreauJeanStepper._normal_velocity``; the contact rows alone: they do not depend
+    on the bilateral rows before them)."""
+    at_start = np.zeros_like(cand[0])
+    at_free = np.zeros_like(cand[0])
     pairs, slots = _selected(valid_slots(cand[4], np.ones(cand[0].shape, dtype=np.bool_)))
     nc = pairs.shape[0]
     if nc == 0:
-        return out
+        return at_start, at_free
     m = 3 * nc
     row_body = np.full((m, 2), -1, dtype=np.int64)
     row_coef = np.zeros((m, 2, 6))
     g = s.geometry
     contact_rows(x, rotation, s.fixed, g[3], g[6], g[7], pairs, slots, cand[1], cand[2],
                  cand[3], row_body, row_coef, 0)
-    values = row_values(row_body, row_coef, nu, 0, m)
+    values_start = row_values(row_body, row_coef, nu, 0, m)
+    values_free = row_values(row_body, row_coef, free, 0, m)
     for c in range(nc):
-        out[pairs[c], slots[c]] = values[3 * c]
-    return out
+        at_start[pairs[c], slots[c]] = values_start[3 * c]
+        at_free[pairs[c], slots[c]] = values_free[3 * c]
+    return at_start, at_free
+
+
+@njit(cache=True)
+def first_round_active(s, cfg, x, rotation, cand, nu, free, previous):
+    """(npair, K) bool: the contacts of the step's first activation round under
+    ``cfg.activation_rule`` (:func:`clearbench.ref_solver.activation.first_round`);
+    ``previous`` (npair, K, 3) the previous step's impulses."""
+    if cfg.activation_rule == RULE_GAP:
+        return valid_slots(cand[4], cand[0] <= cfg.activation_margin)
+    u_start, u_free = _normal_velocities(s, x, rotation, cand, nu, free)
+    active = first_round(
+        cfg.activation_rule, cand[0], u_start, u_free, previous, cfg.time_step, cfg.theta,
+        cfg.activation_margin, cfg.activation_hold, s.pair_restitution,
+        cfg.restitution_threshold)
+    return valid_slots(cand[4], active)
 
 
 @njit(cache=True)
@@ -190,11 +209,7 @@ def single_step(s, cfg, memory, t, x, p, v, omega, history):
         s.force_parameters, memory[3], s.has_springs, cfg.length_step, s.mass_matrix,
         s.inverse_mass, s.cluster_dofs, s.cluster_start)
     cand = candidates(s.geometry, x, rotation)
-    if cfg.projection:
-        active = valid_slots(cand[4], cand[0] <= cfg.activation_margin)
-    else:
-        u_normal = _normal_velocity(s, x, rotation, cand, nu)
-        active = valid_slots(cand[4], cand[0] + 0.5 * h * u_normal <= cfg.activation_margin)
+    active = first_round_active(s, cfg, x, rotation, cand, nu, free, memory[0])
     iterations, sweeps, rounds = 0, 0, 0
     projection_converged = True
     while True:

@@ -12,6 +12,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from clearbench.ref_solver.activation import activation_rule
 from clearbench.ref_solver.compiled.contact_solve import METHOD_CODES
 from clearbench.ref_solver.fc3d_local import LOCAL_KIND
 from clearbench.ref_solver.projection_kernel import closed_gap_slack
@@ -62,6 +63,8 @@ class LoopSettings(NamedTuple):
     max_projection_iterations: int
     max_activation_rounds: int
     activation_margin: float
+    activation_rule: int            # activation.RULE_*
+    activation_hold: float          # StepperSettings.activation_hold [L]
     length_step: float              # finite-difference step of the spring stiffness [L]
     method: int                     # contact_solve.METHOD_*
     hybrid_sweeps: int
@@ -104,6 +107,7 @@ def compile_system(stepper) -> tuple[CompiledSystem, LoopSettings]:
         max_projection_iterations=int(cfg.max_projection_iterations),
         max_activation_rounds=int(cfg.max_activation_rounds),
         activation_margin=float(cfg.activation_margin),
+        activation_rule=activation_rule(cfg), activation_hold=float(cfg.activation_hold),
         length_step=1e-6 * float(cfg.length_scale), method=METHOD_CODES[cfg.method],
         hybrid_sweeps=int(cfg.hybrid_sweeps),
         restitution_threshold=float(cfg.restitution_threshold),
