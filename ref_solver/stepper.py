@@ -17,9 +17,9 @@ One step of length h from state k (Section 2.4 of Akhadkar, Acary, Brogliato 201
    violation is below ``position_tolerance``.
 5. Activation stage: I <- I U {alpha : g_alpha(q_{k+1}) <= 0}; when I grew, the step is redone
    from state k (eq. 22). I starts as the contacts already closed at q_k (gap <= the activation
-   margin), or with ``activation="predicted"`` also those the free motion closes within the
-   step and those held from the previous step (:mod:`.activation`); without projection it
-   starts as Moreau's prediction g + (h/2) u_N <= 0.
+   margin), or with ``activation="held"`` also those held from the previous step
+   (:mod:`.activation`); without projection it starts as Moreau's prediction
+   g + (h/2) u_N <= 0.
 6. Impact localisation (``localise_impacts=True``, with the projection): the steps above apply
    an impact over the whole step. A ball approaching at speed v that crosses the ground at the
    fraction tau of the step ends it (position update with the mean of the pre- and post-impact
@@ -52,7 +52,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from clearbench.ref_solver.activation import (
-    RULE_GAP,
+    RULE_MOREAU,
     RULE_PREDICTED,
     RULES,
     activation_rule,
@@ -121,11 +121,12 @@ class StepperSettings:
         of the step [L].
     activation : str
         With the projection, the first activation round's rule (:mod:`.activation`): ``gap``
-        (the contacts closed at the step's start, the study's scheme) or ``predicted`` (also
-        those that the free motion closes within the step, and those that carried an impulse
-        in the previous step while open by at most ``activation_hold``).
+        (the contacts closed at the step's start, the study's scheme), ``held`` (also those
+        that carried an impulse in the previous step while open by at most
+        ``activation_hold``) or ``predicted`` (also those that the free motion closes within
+        the step).
     activation_hold : float
-        The hold margin of the ``predicted`` rule [L] (>= 0).
+        The hold margin of the ``held`` and ``predicted`` rules [L] (>= 0).
     length_scale : float
         Characteristic length [L] (the scene's largest): finite-difference steps of the
         spring stiffness, the round-off of gaps (``projection_kernel.closed_gap_slack``) and
@@ -466,7 +467,7 @@ class MoreauJeanStepper:
         cand = self._candidates(state.x, rotation)
         rule = activation_rule(cfg)
         u_start = u_free = np.zeros_like(cand[0])
-        if rule != RULE_GAP:
+        if rule in (RULE_MOREAU, RULE_PREDICTED):
             u_start = self._normal_velocity(state, rotation, cand, nu)
         if rule == RULE_PREDICTED:
             u_free = self._normal_velocity(state, rotation, cand, free)

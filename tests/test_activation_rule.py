@@ -13,6 +13,7 @@ from clearbench.adapters.reference.engine import create
 from clearbench.adapters.reference.settings import stepper_settings
 from clearbench.ref_solver.activation import (
     RULE_GAP,
+    RULE_HELD,
     RULE_MOREAU,
     RULE_PREDICTED,
     first_round,
@@ -47,13 +48,21 @@ def test_gap_rule_takes_the_contacts_closed_at_the_start_only():
     assert active.tolist() == [True, False, False, False]
 
 
-def test_predicted_rule_holds_contacts_that_carried_an_impulse_within_the_hold_margin():
+@pytest.mark.parametrize("rule", [RULE_HELD, RULE_PREDICTED])
+def test_held_and_predicted_rules_hold_contacts_that_carried_an_impulse(rule):
     # Separating (the free motion would not close them), open by half and by twice the hold
     # margin, each with and without a normal impulse in the previous step: held only when it
     # carried one and is open by at most the margin.
-    active = _rule(RULE_PREDICTED, [0.5 * HOLD, 0.5 * HOLD, 2 * HOLD, 2 * HOLD],
+    active = _rule(rule, [0.5 * HOLD, 0.5 * HOLD, 2 * HOLD, 2 * HOLD],
                    [1e-3] * 4, [1e-3] * 4, previous_normal=[1e-6, 0.0, 1e-6, 0.0])
     assert active.tolist() == [True, False, False, False]
+
+
+def test_held_rule_does_not_predict():
+    # Open by 1 um and closing within the step at 1 m/s (start and free velocity), no impulse
+    # in the previous step: the held rule leaves it to the activation loop.
+    assert not _rule(RULE_HELD, [1e-6], [-1.0], [-1.0])[0]
+    assert _rule(RULE_PREDICTED, [1e-6], [-1.0], [-1.0])[0]
 
 
 def test_free_motion_adds_what_the_free_motion_closes_within_the_step():
@@ -94,9 +103,8 @@ def test_moreau_rule_is_the_half_step_prediction_at_the_start_velocity():
 def test_the_option_reaches_the_stepper_and_refuses_unknown_rules():
     scene = get_scene("clearance-pendulum")
     assert stepper_settings("default", scene, RunSettings()).activation == "gap"
-    chosen = stepper_settings("default", scene,
-                              RunSettings(options={"activation": "predicted"}))
-    assert chosen.activation == "predicted"
+    chosen = stepper_settings("default", scene, RunSettings(options={"activation": "held"}))
+    assert chosen.activation == "held"
     # The hold margin defaults to 1e-2 of the scene's smallest feature, like the activation
     # margin (1e-10 of it) a length of the scene's own scale.
     assert chosen.activation_hold == pytest.approx(1e-2 * min(feature_lengths(scene)),

@@ -119,11 +119,12 @@ def test_compiled_loop_agrees_with_python_step_on_every_supported_scene(name, re
     _compare(name)
 
 
+@pytest.mark.parametrize("rule", ["held", "predicted"])
 @pytest.mark.parametrize("name", ["clearance-pendulum", "slider-crank", "box-grid", "c60-on"])
-def test_both_loops_apply_the_predicted_activation_alike(name):
-    # The first activation round's rule other than the default (ref_solver/activation.py), on
+def test_both_loops_apply_the_other_activation_rules_alike(name, rule):
+    # The first activation round's rules other than the default (ref_solver/activation.py), on
     # scenes with clearance joints, ideal joints and resting contacts.
-    _compare(name, {"activation": "predicted"})
+    _compare(name, {"activation": rule})
 
 
 def test_unsupported_scene_falls_back_with_its_reason():

@@ -1,7 +1,7 @@
 """The reference engine's expectation figures, scene by scene at full precision, and two such
 tables compared: is a revision's physics unchanged?
 
-    .venv/bin/python tools/physics_rows.py [SCENE ...] > this.tsv
+    .venv/bin/python tools/physics_rows.py [SCENE ...] [--option KEY=VALUE ...] > this.tsv
     (cd BASE_CHECKOUT && .venv/bin/python /path/to/tools/physics_rows.py [SCENE ...]) > base.tsv
     python3 tools/physics_rows.py --compare base.tsv this.tsv
 
@@ -26,8 +26,9 @@ import sys
 import time
 
 
-def measure(names: list[str]) -> None:
-    """Print the rows of each scene of ``names`` (all library scenes when empty)."""
+def measure(names: list[str], options: dict | None = None) -> None:
+    """Print the rows of each scene of ``names`` (all library scenes when empty), with the
+    reference's ``options`` when given (a revision that predates them is run without)."""
     from clearbench.harness.studies.benchmarks import physics
     from clearbench.scenarios.library import scene_names
 
@@ -36,7 +37,8 @@ def measure(names: list[str]) -> None:
         start = time.perf_counter()
         physics.scene_names = lambda tag=None, only=name: [only]  # one scene per table
         try:
-            rows = physics.engine_physics_table("reference", "default")
+            rows = (physics.engine_physics_table("reference", "default", options=options)
+                    if options else physics.engine_physics_table("reference", "default"))
         except Exception as error:  # a scene that fails is a row, the others go on
             print(f"{name}\tERROR\t{type(error).__name__}: {error}", flush=True)
             continue
@@ -93,11 +95,16 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("scenes", nargs="*", metavar="SCENE")
     parser.add_argument("--compare", nargs=2, metavar=("BASE_TSV", "THIS_TSV"))
+    parser.add_argument("--option", action="append", default=[], metavar="KEY=VALUE",
+                        help="a reference option of every run (a scheme variant against the "
+                             "default: two tables of one revision)")
     args = parser.parse_args(argv)
     if args.compare:
         compare(*args.compare)
     else:
-        measure(args.scenes)
+        from clearbench.harness.cli.common import assignments
+
+        measure(args.scenes, assignments(args.option, "--option"))
     return 0
 
 

@@ -14,10 +14,10 @@ Presets (each a separate engine variant in results):
 Options (``RunSettings.options``) override: ``theta``, ``projection``, ``method``,
 ``tolerance``, ``max_iterations``, ``position_tolerance``, ``activation_margin`` (default
 1e-10 x the smallest feature: contacts open by less at a step's start are active from its
-start), ``activation`` (``gap``, the study's rule, or ``predicted``: the first activation
-round also holds the contacts the free motion closes within the step and those that carried
-an impulse in the previous step while open by at most ``activation_hold``, default 1e-2 x the
-smallest feature; ref_solver/activation.py),
+start), ``activation`` (``gap``, the study's rule; ``held``: the first activation round also
+holds the contacts that carried an impulse in the previous step while open by at most
+``activation_hold``, default 1e-2 x the smallest feature; ``predicted``: also the contacts the
+free motion closes within the step; ref_solver/activation.py),
 ``restitution_threshold`` (default 2 |g| h: slower impacts are plastic),
 ``joint_law`` (``midpoint`` or ``end``), ``localise_impacts`` (true or false; every preset
 with the projection has it on: an impact with e > 0 is applied at its crossing time within the

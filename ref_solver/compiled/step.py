@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from clearbench.ref_solver.activation import RULE_GAP, first_round
+from clearbench.ref_solver.activation import RULE_GAP, RULE_HELD, first_round
 from clearbench.ref_solver.compiled.contact_solve import solve
 from clearbench.ref_solver.constraints import contact_rows, row_values
 from clearbench.ref_solver.forces import rotation_matrices
@@ -79,7 +79,10 @@ def first_round_active(s, cfg, x, rotation, cand, nu, free, previous):
     ``previous`` (npair, K, 3) the previous step's impulses."""
     if cfg.activation_rule == RULE_GAP:
         return valid_slots(cand[4], cand[0] <= cfg.activation_margin)
-    u_start, u_free = _normal_velocities(s, x, rotation, cand, nu, free)
+    if cfg.activation_rule == RULE_HELD:
+        u_start = u_free = np.zeros_like(cand[0])   # not read by the rule
+    else:
+        u_start, u_free = _normal_velocities(s, x, rotation, cand, nu, free)
     active = first_round(
         cfg.activation_rule, cand[0], u_start, u_free, previous, cfg.time_step, cfg.theta,
         cfg.activation_margin, cfg.activation_hold, s.pair_restitution,

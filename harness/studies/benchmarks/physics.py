@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -44,15 +45,18 @@ class PhysicsRow:
 
 
 def engine_physics_table(engine_name: str = "reference", preset: str = "default",
-                         time_steps: tuple = (None,), tag: str | None = None) -> list[PhysicsRow]:
+                         time_steps: tuple = (None,), tag: str | None = None,
+                         options: Mapping | None = None) -> list[PhysicsRow]:
     """Every expectation figure of every library scene (optionally with ``tag``) for one engine
-    and preset, at each of ``time_steps`` (None: the scene's own step) [scene units]."""
+    and preset (with the engine ``options``), at each of ``time_steps`` (None: the scene's own
+    step) [scene units]."""
     engine = importlib.import_module(engine_module_path(engine_name)).create(preset)
     rows = []
     for name in scene_names(tag):
         scene = get_scene(name)
         for step in time_steps:
-            trajectory = engine.run(scene, RunSettings(time_step=step))
+            trajectory = engine.run(scene, RunSettings(time_step=step,
+                                                       options=dict(options or {})))
             for result in evaluate(scene, trajectory):
                 for figure, value in result.figures.items():
                     rows.append(PhysicsRow(name, trajectory.time_step, result.name, figure,
