@@ -57,6 +57,12 @@ def test_a_changed_scene_preset_or_code_is_another_run(tmp_path, monkeypatch):
     other_preset = StudyRuns(ResultsStore(tmp_path), run_missing=False,
                              engine="reference[nsgs]")
     assert other_preset.spec(request).key != key
+    # An engine option (a scheme variant to validate) is another run, named in the reports.
+    held = StudyRuns(ResultsStore(tmp_path), run_missing=False, options={"activation": "held"})
+    assert held.spec(request).key != key
+    assert held.spec(request).options_dict == {"activation": "held"}
+    assert held.settings_label == "default; options activation=held"
+    assert runs.settings_label == "default"
     monkeypatch.setitem(clearbench._SOURCE_DIGESTS, clearbench.PHYSICS_SUBPACKAGES, "0" * 16)
     assert StudyRuns(ResultsStore(tmp_path), run_missing=False).spec(request).key != key
 
@@ -97,6 +103,13 @@ def test_identify_notes_a_run_past_its_limit_on_its_variant(tmp_path, capsys):
 def test_a_bad_preset_is_refused_before_any_run(tmp_path, capsys):
     assert main(["c60", "validate", "--preset", "nonsense", "--store", str(tmp_path)]) == 2
     assert "nonsense" in capsys.readouterr().err
+    assert not (tmp_path / "runs.sqlite").exists()
+
+
+@pytest.mark.parametrize("option", ["activation=nonsense", "no_such_option=1"])
+def test_a_bad_engine_option_is_refused_before_any_run(tmp_path, capsys, option):
+    assert main(["c60", "validate", "--option", option, "--store", str(tmp_path)]) == 2
+    assert option.split("=")[0] in capsys.readouterr().err
     assert not (tmp_path / "runs.sqlite").exists()
 
 

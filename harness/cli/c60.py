@@ -144,10 +144,10 @@ def _study_runs(args: argparse.Namespace, campaign: str, run_missing: bool = Tru
     """The runs of a study in the command's store, made by the command's runner with the
     reference engine's ``--preset`` (checked before any run: exit 2)."""
     engine = resolve_engine(f"reference[{args.preset}]")
-    store = open_store(args)
-    runner = make_runner(args, store, total=2)   # a study makes several runs
     options = assignments(args.option, "--option")
     check_options(engine, options)
+    store = open_store(args)
+    runner = make_runner(args, store, total=2)   # a study makes several runs
     return StudyRuns(store, runner, engine, timeout=args.timeout, run_missing=run_missing,
                      rerun=args.rerun, campaign=campaign, options=options)
 
