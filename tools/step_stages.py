@@ -26,7 +26,7 @@ from clearbench.adapters.base import RunSettings
 from clearbench.adapters.reference.build import build
 from clearbench.adapters.reference.engine import create
 from clearbench.adapters.reference.run import _memory
-from clearbench.harness.cli.common import assignments
+from clearbench.harness.cli.common import add_engine_options_option, engine_options
 from clearbench.ref_solver.compiled.step import (
     _projection_stage,
     _velocity_stage,
@@ -126,12 +126,11 @@ def main() -> None:
     parser.add_argument("skip", type=int, help="steps taken first by the Python step")
     parser.add_argument("--dt", type=float, default=None,
                         help="time step [the scene's time unit]; default the scene's")
-    parser.add_argument("--option", action="append", default=[], metavar="NAME=VALUE",
-                        help="a reference option (as `clearbench run --option`)")
+    add_engine_options_option(parser, "a reference option (as `clearbench run --option`)")
     args = parser.parse_args()
     scene = get_scene(args.scene)
     engine = create("default")
-    options = assignments(args.option, "--option")
+    options = engine_options(args)
     engine.check_options(options)
     model = build(scene, engine.run_settings(scene, RunSettings(time_step=args.dt,
                                                                 options=options)))

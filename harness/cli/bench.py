@@ -22,8 +22,9 @@ from clearbench.harness.cli.common import (
     UserError,
     add_engine_module_option,
     add_engine_option,
-    assignments,
+    add_engine_options_option,
     engine_modules,
+    engine_options,
 )
 from clearbench.harness.run.engine_choice import RunInputError, resolve_engine
 from clearbench.harness.run.spec import DEFAULT_TIMEOUT
@@ -318,9 +319,8 @@ def _table_options(parser: argparse.ArgumentParser) -> None:
 
 
 def _engine_option(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--option", action="append", default=[], metavar="KEY=VALUE",
-                        help="engine option over every preset of the table (repeatable; "
-                        "checked by each engine before any run)")
+    add_engine_options_option(parser, "engine option over every preset of the table "
+                              "(repeatable; checked by each engine before any run)")
 
 
 def _physics_table_options(parser: argparse.ArgumentParser) -> None:
@@ -361,7 +361,7 @@ def _print_physics_table(labels: list[str], args: argparse.Namespace) -> int:
     any run), run every cell and print the Markdown."""
     if args.reference:
         labels = [*labels, "reference"]
-    options = assignments(args.option, "--option")
+    options = engine_options(args)
     engines = _engines(labels, options)
     scenes = tuple(args.scenes or physics_table.DEFAULT_SCENES)
     missing = sorted(set(scenes) - set(scene_names()))
@@ -410,7 +410,7 @@ def bench_contact_cost(args: argparse.Namespace) -> int:
     time_steps = tuple(args.time_steps or (1e-3, 1e-4))
     if any(not dt > 0 for dt in time_steps) or not args.horizon > 0:
         raise UserError(f"--dt and --horizon must be > 0, got {time_steps}, {args.horizon}")
-    options = assignments(args.option, "--option")
+    options = engine_options(args)
     engines = _engines(list(args.engines or []), options)
     rows = contact_cost.contact_costs(
         engines, boxes, time_steps, args.horizon,

@@ -33,9 +33,10 @@ from clearbench.harness.cli.commands import command_help
 from clearbench.harness.cli.common import (
     UserError,
     add_engine_option,
+    add_engine_options_option,
     add_runner_options,
-    assignments,
     engine_modules,
+    engine_options,
     make_runner,
     open_store,
 )
@@ -134,9 +135,9 @@ def _add_run_options(parser, report: Path, what: str) -> None:
     """--out, --preset and the runner's options of the commands that run the C-60 studies."""
     parser.add_argument("--out", type=Path, default=report, help=f"{what} (default {report})")
     parser.add_argument("--preset", default="default", help="reference engine preset")
-    parser.add_argument("--option", action="append", default=[], metavar="KEY=VALUE",
-                        help="a reference engine option of every run (as `clearbench run "
-                             "--option`; repeatable), for instance a scheme variant")
+    add_engine_options_option(parser, "a reference engine option of every run (as "
+                              "`clearbench run --option`; repeatable), for instance a scheme "
+                              "variant")
     add_runner_options(parser, timeout=STUDY_TIMEOUT, engine_module=False)
 
 
@@ -144,7 +145,7 @@ def _study_runs(args: argparse.Namespace, campaign: str, run_missing: bool = Tru
     """The runs of a study in the command's store, made by the command's runner with the
     reference engine's ``--preset`` (checked before any run: exit 2)."""
     engine = resolve_engine(f"reference[{args.preset}]")
-    options = assignments(args.option, "--option")
+    options = engine_options(args)
     check_options(engine, options)
     store = open_store(args)
     runner = make_runner(args, store, total=2)   # a study makes several runs

@@ -33,6 +33,16 @@ def default_store() -> str:
     return os.environ.get("CLEARBENCH_STORE", DEFAULT_STORE)
 
 
+def add_engine_options_option(parser: argparse.ArgumentParser, help: str) -> None:
+    """``--option KEY=VALUE`` (repeatable): engine options, read by :func:`engine_options`."""
+    parser.add_argument("--option", action="append", default=[], metavar="KEY=VALUE", help=help)
+
+
+def engine_options(args: argparse.Namespace) -> dict:
+    """The engine options of ``--option`` (:func:`add_engine_options_option`), parsed."""
+    return assignments(args.option, "--option")
+
+
 def add_store_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--store", default=None, metavar="DIR",
                         help=f"results store directory (default: $CLEARBENCH_STORE or "

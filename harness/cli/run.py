@@ -10,9 +10,11 @@ from clearbench.harness.cli.commands import command_help
 from clearbench.harness.cli.common import (
     UserError,
     add_engine_option,
+    add_engine_options_option,
     add_runner_options,
     assignments,
     engine_modules,
+    engine_options,
     make_runner,
     open_store,
 )
@@ -45,8 +47,8 @@ def register(subparsers) -> None:
                         help="keep one sample every N steps (default 1)")
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                         help="a parameter of the scene's factory, e.g. radial_clearance=1e-5")
-    parser.add_argument("--option", action="append", default=[], metavar="KEY=VALUE",
-                        help="an engine option overriding the preset, e.g. tolerance=1e-10")
+    add_engine_options_option(parser, "an engine option overriding the preset, e.g. "
+                              "tolerance=1e-10")
     parser.add_argument("--out", metavar="FILE.npz", help="also write the trajectory here")
     parser.add_argument("--json", action="store_true", help="print the stored row as JSON")
     add_runner_options(parser)
@@ -58,7 +60,7 @@ def run_one(args: argparse.Namespace) -> int:
                          scene_parameters=assignments(args.set, "--set"),
                          time_step=args.dt, horizon=args.horizon,
                          record_every=args.record_every,
-                         options=assignments(args.option, "--option"),
+                         options=engine_options(args),
                          timeout=args.timeout, extra_engine_modules=engine_modules(args),
                          campaign="run")
     store = open_store(args)
