@@ -23,6 +23,10 @@ from clearbench.ref_solver.contact_problem import (
     SolverResult,
     SolverStatus,
 )
+from clearbench.ref_solver.dense_kernels import (
+    BILATERAL_CONDITION_LIMIT,
+    bilateral_block_operator,
+)
 from clearbench.ref_solver.fc3d_local import LOCAL_FAILED, LOCAL_KIND, N_MAT, N_VEC, solve_local
 from clearbench.ref_solver.fc3d_residual import (
     csr_matvec_plus,
@@ -68,17 +72,19 @@ def _extract_blocks(indptr, indices, data, n_bilateral, blocks):
 
 
 def bilateral_solve_operator(W_dense_bb: np.ndarray) -> np.ndarray:
-    """Dense operator S with r_b = S rhs solving W_bb r_b = rhs (pseudo-inverse if singular).
+    """Dense operator S with r_b = S rhs solving W_bb r_b = rhs (pseudo-inverse if singular):
+    :func:`dense_kernels.bilateral_block_operator`.
 
     Redundant bilateral rows (a singular W_bb) get the minimum-norm impulses.
     """
     if W_dense_bb.size == 0:
         return np.zeros((0, 0))
-    condition = np.linalg.cond(W_dense_bb)
-    if np.isfinite(condition) and condition < 1e12:
-        return np.linalg.inv(W_dense_bb)
-    logger.info("bilateral block ill-conditioned (cond %.3g): using its pseudo-inverse", condition)
-    return np.linalg.pinv(W_dense_bb, rcond=1e-12)
+    operator, pseudo = bilateral_block_operator(
+        np.ascontiguousarray(W_dense_bb, dtype=np.float64))
+    if pseudo:
+        logger.info("bilateral block ill-conditioned (cond >= %.0e): using its pseudo-inverse",
+                    BILATERAL_CONDITION_LIMIT)
+    return operator
 
 
 def bilateral_operator_of(problem: ContactProblem) -> np.ndarray:

@@ -43,9 +43,11 @@ _NO_STALL = np.int64(0)
 @njit(cache=True)
 def proximal_newton_dense(W, q, mu, n_bilateral, r0, relative_weight, tolerance, use_max,
                           inner_iterations, use_floor, local_tolerance, local_max_iterations,
-                          history):
+                          history, outer_iterations):
     """Proximal-point Newton (module docstring) on (W (m, m), q (m,), mu (nc,), n_bilateral)
-    from ``r0`` (m,) (not modified). ``history`` (>= inner_iterations,): scratch.
+    from ``r0`` (m,) (not modified): at most ``outer_iterations`` (the chain passes
+    ``PROXIMAL_OUTER_ITERATIONS``) outer iterations of at most ``inner_iterations`` Newton
+    iterations each. ``history`` (>= inner_iterations,): scratch.
 
     Returns (r (m,), u = W r + q (m,), Newton iterations summed over the outer iterations,
     the original problem's residual |F| / |q|, the same / max(|q|, |r|, |u|), the one of the
@@ -65,7 +67,7 @@ def proximal_newton_dense(W, q, mu, n_bilateral, r0, relative_weight, tolerance,
     shifted_q = np.empty(m)
     iterations = 0
     residual_q = residual_max = residual = np.inf
-    for _ in range(PROXIMAL_OUTER_ITERATIONS):
+    for _ in range(outer_iterations):
         for i in range(m):
             shifted_q[i] = q[i] - weight * r[i]
         _, inner, _, _, _, _, _, _ = newton_dense_kernel(

@@ -70,7 +70,11 @@ from clearbench.ref_solver.contact_problem import (
     SolverResult,
     SolverStatus,
 )
-from clearbench.ref_solver.fc3d_proximal import DEFAULT_RELATIVE_WEIGHT, proximal_newton_dense
+from clearbench.ref_solver.fc3d_proximal import (
+    DEFAULT_RELATIVE_WEIGHT,
+    PROXIMAL_OUTER_ITERATIONS,
+    proximal_newton_dense,
+)
 from clearbench.ref_solver.fc3d_solve import solve_contact_problem
 from clearbench.ref_solver.forces import (
     no_angle_memory,
@@ -635,7 +639,8 @@ class MoreauJeanStepper:
             float(self.settings.proximal_rescue), float(solver.tolerance),
             np.bool_(solver.use_max_normalisation), np.int64(cap),
             np.bool_(solver.roundoff_floor), float(solver.local_tolerance),
-            np.int64(solver.local_max_iterations), np.empty(cap))
+            np.int64(solver.local_max_iterations), np.empty(cap),
+            np.int64(PROXIMAL_OUTER_ITERATIONS))
         return SolverResult(
             r=r, u=u, iterations=int(iterations), residual=float(residual),
             residual_q=float(residual_q), residual_max=float(residual_max),

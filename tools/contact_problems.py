@@ -3,7 +3,8 @@
     .venv/bin/python -m tools.contact_problems record c60-on --dt 0.004 --save on_4us.npz
     .venv/bin/python -m tools.contact_problems replay on_4us.npz
 
-``record`` steps SCENE in the reference engine with the Python step (the default preset;
+``record`` steps SCENE in the reference engine with the Python step (the default preset and
+the engine options of ``--option KEY=VALUE``, kept in the file and used again by ``replay``;
 ``--skip`` steps first, then ``--steps`` steps, default the whole horizon) and keeps every
 one-step problem the stepper's ``_solve`` receives, one per activation round: the dense
 Delassus operator W (m, m), the free velocity q (m,), mu (nc,), the bilateral rows, the warm
@@ -27,6 +28,7 @@ C-60's problems have).
 from __future__ import annotations
 
 import argparse
+import json
 import time
 
 import numpy as np
@@ -34,6 +36,7 @@ import numpy as np
 from clearbench.adapters.base import RunSettings
 from clearbench.adapters.reference.build import build
 from clearbench.adapters.reference.engine import create
+from clearbench.harness.cli.common import add_engine_options_option, engine_options
 from clearbench.ref_solver.compiled.contact_solve import NO_NEWTON_FIRST, solve
 from clearbench.ref_solver.compiled.system_arrays import compile_system
 from clearbench.scenarios.library import get_scene
@@ -43,14 +46,24 @@ from clearbench.scenarios.library import get_scene
 HEAVY = 1000
 
 
-def _model(scene_name: str, time_step: float | None):
+def _model(scene_name: str, time_step: float | None, options: dict | None = None):
     scene = get_scene(scene_name)
-    return build(scene, create("default").run_settings(scene, RunSettings(time_step=time_step)))
+    settings = RunSettings(time_step=time_step, options=dict(options or {}))
+    return build(scene, create("default").run_settings(scene, settings))
 
 
-def record(scene_name: str, time_step: float | None, skip: int, steps: int | None) -> dict:
+def recorded_options(data) -> dict:
+    """The engine options a recording was made with (none in files written before they were
+    kept)."""
+    if "options" not in data:
+        return {}
+    return json.loads(str(data["options"]))
+
+
+def record(scene_name: str, time_step: float | None, skip: int, steps: int | None,
+           options: dict | None = None) -> dict:
     """Every one-step problem of the run (module docstring), as the arrays of the file."""
-    model = _model(scene_name, time_step)
+    model = _model(scene_name, time_step, options)
     stepper, state = model.stepper, model.state
     for _ in range(skip):
         state = stepper.step(state).state
@@ -75,6 +88,7 @@ def record(scene_name: str, time_step: float | None, skip: int, steps: int | Non
     sizes = np.array([entry[2].size for entry in kept], dtype=np.int64)
     return {
         "scene": np.array(scene_name), "time_step": np.array(stepper.settings.time_step),
+        "options": np.array(json.dumps(options or {}, sort_keys=True)),
         "step": np.array([entry[0] for entry in kept], dtype=np.int64),
         "rows": sizes,
         "W": np.concatenate([entry[1].ravel() for entry in kept]) if kept else np.zeros(0),
@@ -122,7 +136,8 @@ def replay(data) -> dict:
     "converged" (P,), "equal" (problems whose impulses are the recorded ones to the bit),
     "largest_velocity_difference" (the largest |W (r - r_recorded)| / |q|), "seconds"}."""
     time_step = float(data["time_step"])
-    _, cfg = compile_system(_model(str(data["scene"]), time_step).stepper)
+    model = _model(str(data["scene"]), time_step, recorded_options(data))
+    _, cfg = compile_system(model.stepper)
     history = np.empty(max(cfg.max_iterations, cfg.hybrid_sweeps, 1000) + 1)
     memory = np.array([NO_NEWTON_FIRST], dtype=np.int64)
     cases = problems(data)
@@ -165,12 +180,13 @@ def main() -> None:
     rec.add_argument("--steps", type=int, default=None,
                      help="steps recorded (default: to the scene's horizon)")
     rec.add_argument("--save", required=True, help="the .npz file written")
+    add_engine_options_option(rec, "reference engine option of the recorded run (repeatable)")
     again = commands.add_parser("replay", help="solve a recording's problems again")
     again.add_argument("file")
     args = parser.parse_args()
     if args.command == "record":
         started = time.perf_counter()
-        data = record(args.scene, args.dt, args.skip, args.steps)
+        data = record(args.scene, args.dt, args.skip, args.steps, engine_options(args))
         np.savez_compressed(args.save, **data)
         print(f"{args.scene}, step {float(data['time_step']):g}: {data['rows'].size} problems "
               f"kept in {args.save} ({time.perf_counter() - started:.1f} s)")

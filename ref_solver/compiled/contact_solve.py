@@ -19,7 +19,7 @@ from clearbench.ref_solver.dense_kernels import bilateral_operator_dense
 from clearbench.ref_solver.fc3d_newton_dense import CONVERGED, ROUNDOFF, newton_dense_kernel
 from clearbench.ref_solver.fc3d_nsgs import ROUNDOFF_CODE as NSGS_ROUNDOFF
 from clearbench.ref_solver.fc3d_nsgs import nsgs_kernel
-from clearbench.ref_solver.fc3d_proximal import proximal_newton_dense
+from clearbench.ref_solver.fc3d_proximal import PROXIMAL_OUTER_ITERATIONS, proximal_newton_dense
 
 #: Method codes of :class:`.system_arrays.LoopSettings` (``StepperSettings.method``).
 METHOD_NSGS, METHOD_NEWTON, METHOD_HYBRID = 0, 1, 2
@@ -33,6 +33,8 @@ HYBRID_NEWTON_ITERATIONS = 200
 #: argument: scalars reach the kernels as ``np.int64`` / ``np.bool_`` values, the types a call
 #: from Python has, so that each kernel is compiled once.
 NO_STALL = np.int64(0)
+#: The proximal attempt's outer iterations, typed as the other scalars.
+PROXIMAL_OUTER = np.int64(PROXIMAL_OUTER_ITERATIONS)
 
 
 @njit(cache=True)
@@ -122,7 +124,7 @@ def solve(w, q, mu, n_bilateral, r0, cfg, newton_first, history):
             r, _, its, _, _, res, ok = proximal_newton_dense(
                 w, q, mu, n_bilateral, start, cfg.proximal_rescue, cfg.tolerance, cfg.use_max,
                 np.int64(HYBRID_NEWTON_ITERATIONS), cfg.roundoff_floor, cfg.local_tolerance,
-                cfg.local_max_iterations, history)
+                cfg.local_max_iterations, history, PROXIMAL_OUTER)
         elif kinds[a] == 2:
             r, its, res, ok = _nsgs(csr, q, mu, n_bilateral, operator, start,
                                     cfg.max_iterations, cfg, history)
