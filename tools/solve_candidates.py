@@ -18,7 +18,7 @@ residual under its round-off floor counting as converged, as the chain does). Ca
 - ``newton>prox:W:N[:from-newton]>chain``: that Newton; where it did not converge,
   proximal-point Newton of weight W, at most N outer iterations of at most 50 Newton
   iterations each, from the warm start (or from Newton's end); where that did not converge
-  either, the chain;
+  either, the chain (``...>chain-cap:N``: the chain of ``chain-cap:N``);
 - ``proximal-W``: proximal-point Newton (``ref_solver/fc3d_proximal.py``) from the warm
   start with the relative weight W (e.g. ``proximal-1e-6``);
 - ``admm``: ADMM on the cone complementarity problem with De Saxce's correction and an adaptive
@@ -55,7 +55,8 @@ from clearbench.ref_solver.fc3d_proximal import PROXIMAL_OUTER_ITERATIONS, proxi
 from clearbench.ref_solver.fc3d_residual import project_on_cone
 from tools.contact_problems import HEAVY, _model, problems, recorded_options
 
-#: The ADMM's iteration cap (each iteration: two triangular solves and one product with W).
+#: The ADMM's iteration cap (each iteration: products with (W + (rho + eta) I)^-1 and with W,
+#: both (m, m), and a projection per contact).
 ADMM_ITERATIONS = 5000
 #: ``admm+newton`` hands over to Newton once the residual is under this factor times the
 #: square root of the tolerance (1e-6 for the default tolerance 1e-12).
@@ -176,8 +177,8 @@ def run_candidate(name: str, cases, cfg) -> dict:
     tol, use_max = cfg.tolerance, cfg.use_max
 
     chain_cfg = cfg
-    if name.startswith("chain-cap:"):
-        chain_cfg = cfg._replace(max_iterations=int(name.split(":")[1]))
+    if "chain-cap:" in name:
+        chain_cfg = cfg._replace(max_iterations=int(name.split("chain-cap:")[1]))
 
     def one(W, q, mu, nb, r0):
         if name == "chain" or name.startswith("chain-cap:"):
@@ -200,7 +201,7 @@ def run_candidate(name: str, cases, cfg) -> dict:
             if ok:
                 return r, its
             memory[0] = NO_NEWTON_FIRST
-            r, its2, _, _ = solve(W, q, mu, np.int64(nb), r0, cfg, memory, history)
+            r, its2, _, _ = solve(W, q, mu, np.int64(nb), r0, chain_cfg, memory, history)
             return r, its + its2
         if name.startswith("newton>chain"):
             cap = int(name.split("-")[1]) if "-" in name else NEWTON_ITERATIONS
