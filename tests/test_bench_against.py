@@ -40,6 +40,16 @@ def test_unknown_revision_is_a_user_error(capsys, benchmark):
     assert "does not know the revision" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("benchmark, scene", [("reference", "pendulum"), ("c60", "c60-bogus")])
+def test_a_scene_outside_the_benchmarks_cases_is_refused_before_any_run(capsys, benchmark,
+                                                                         scene):
+    # --scenes filters the benchmark's own cases: a name outside them used to leave a table
+    # without that scene and no word why
+    assert main(["bench", benchmark, "--against", "HEAD", "--scenes", scene]) == 2
+    err = capsys.readouterr().err
+    assert repr(scene) in err and "bench engines --against REV --scene NAME" in err
+
+
 def test_against_applies_to_c60_reference_and_engines_only(capsys):
     # --against is an option of those three benchmarks only: argparse refuses it elsewhere
     with pytest.raises(SystemExit) as caught:

@@ -56,6 +56,12 @@ def _checked_baseline(args: argparse.Namespace) -> str:
     for step in getattr(args, "dt", None) or ():
         if not step > 0.0:
             raise UserError(f"--dt must be > 0 (a time step in the scene's time unit), got {step}")
+    known = [scene for scene, _, _ in CASES.get(getattr(args, "benchmark", None), ())]
+    for scene in getattr(args, "scenes", None) or ():
+        if scene not in known:
+            raise UserError(f"--scenes {scene!r} is not a case of bench {args.benchmark} "
+                            f"--against (its cases: {', '.join(known)}; 'bench engines "
+                            f"--against REV --scene NAME' takes any library scene)")
     return commit
 
 
