@@ -3,6 +3,7 @@ ratio."""
 
 from __future__ import annotations
 
+import argparse
 import subprocess
 import sys
 
@@ -48,6 +49,14 @@ def test_a_scene_outside_the_benchmarks_cases_is_refused_before_any_run(capsys, 
     assert main(["bench", benchmark, "--against", "HEAD", "--scenes", scene]) == 2
     err = capsys.readouterr().err
     assert repr(scene) in err and "bench engines --against REV --scene NAME" in err
+
+
+def test_bench_engines_against_takes_any_library_scene():
+    # its --scene (dest ``scenes`` too) is not filtered by the c60 / reference cases
+    from clearbench.harness.cli import bench_against
+    args = argparse.Namespace(benchmark="engines", against="HEAD", repeat=1, dt=None,
+                              scenes=["pendulum"])
+    assert len(bench_against._checked_baseline(args)) == 40
 
 
 def test_against_applies_to_c60_reference_and_engines_only(capsys):
