@@ -38,7 +38,7 @@ from clearbench.adapters.reference.build import build
 from clearbench.adapters.reference.engine import create
 from clearbench.harness.cli.common import add_engine_options_option, engine_options
 from clearbench.ref_solver.compiled.contact_solve import NO_NEWTON_FIRST, solve
-from clearbench.ref_solver.compiled.system_arrays import compile_system
+from clearbench.ref_solver.compiled.system_arrays import compile_system, history_length
 from clearbench.scenarios.library import get_scene
 
 #: Iteration counts of a problem at least this large are its run's heavy tail (the whole chain
@@ -138,7 +138,7 @@ def replay(data) -> dict:
     time_step = float(data["time_step"])
     model = _model(str(data["scene"]), time_step, recorded_options(data))
     _, cfg = compile_system(model.stepper)
-    history = np.empty(max(cfg.max_iterations, cfg.hybrid_sweeps, 1000) + 1)
+    history = np.empty(history_length(cfg))
     memory = np.array([NO_NEWTON_FIRST], dtype=np.int64)
     cases = problems(data)
     iterations = np.zeros(len(cases), dtype=np.int64)

@@ -47,10 +47,14 @@ import time
 import numpy as np
 from numba import njit
 
-from clearbench.ref_solver.compiled.contact_solve import NO_NEWTON_FIRST, NO_STALL, solve
-from clearbench.ref_solver.compiled.system_arrays import compile_system
+from clearbench.ref_solver.compiled.contact_solve import (
+    HYBRID_NEWTON_ITERATIONS,
+    NO_NEWTON_FIRST,
+    _newton,
+    solve,
+)
+from clearbench.ref_solver.compiled.system_arrays import compile_system, history_length
 from clearbench.ref_solver.dense_kernels import residuals, roundoff_floor_dense
-from clearbench.ref_solver.fc3d_newton_dense import newton_dense_kernel
 from clearbench.ref_solver.fc3d_proximal import PROXIMAL_OUTER_ITERATIONS, proximal_newton_dense
 from clearbench.ref_solver.fc3d_residual import project_on_cone
 from tools.contact_problems import HEAVY, _model, problems, recorded_options
@@ -68,7 +72,9 @@ ADMM_PROXIMAL = 1e-8
 #: the primal residual exceeds ``ADMM_RHO_BALANCE`` times the dual one, or the reverse.
 ADMM_RHO_FACTOR = 10.0
 ADMM_RHO_BALANCE = 10.0
-NEWTON_ITERATIONS = 200
+#: Newton's cap, as the chain's Newton attempts (``contact_solve._newton`` runs it).
+NEWTON_ITERATIONS = HYBRID_NEWTON_ITERATIONS
+NEWTON_CAP = np.int64(NEWTON_ITERATIONS)
 #: An unconverged result this many times the tolerance away counts as failed outright: the
 #: chain itself accepts residuals up to about 5e-12 (four to five times the default 1e-12) on
 #: NSGS's round-off floor, a looser estimate than the dense one this tool judges with.
@@ -152,17 +158,6 @@ def admm(W, q, mu, nb, r0, tolerance, use_max, max_iterations, stop_at):
     return z, max_iterations, residual
 
 
-@njit(cache=False)
-def newton(W, q, mu, nb, r0, tolerance, use_max, local_tolerance, local_max, history,
-           max_iterations=NEWTON_ITERATIONS):
-    r = r0.copy()
-    u = np.empty(q.size)
-    _, its, res, _, _, _, _, _ = newton_dense_kernel(
-        W, q, mu, nb, r, u, tolerance, use_max, np.int64(max_iterations), True, NO_STALL,
-        NO_STALL, local_tolerance, local_max, history, np.bool_(False))
-    return r, its, res
-
-
 def _judged(W, q, mu, nb, r, tolerance, use_max) -> tuple[float, bool]:
     u = W @ r + q
     _, residual_q, residual_max = residuals(r, u, q, mu, nb)
@@ -172,7 +167,7 @@ def _judged(W, q, mu, nb, r, tolerance, use_max) -> tuple[float, bool]:
 
 
 def run_candidate(name: str, cases, cfg) -> dict:
-    history = np.empty(max(cfg.max_iterations, cfg.hybrid_sweeps, 1000) + 1)
+    history = np.empty(history_length(cfg))
     memory = np.array([NO_NEWTON_FIRST], dtype=np.int64)
     tol, use_max = cfg.tolerance, cfg.use_max
 
@@ -188,8 +183,7 @@ def run_candidate(name: str, cases, cfg) -> dict:
             # newton>prox:WEIGHT:OUTER[:from-newton]>chain
             fields = name.split(">")[1].split(":")
             weight, outer = float(fields[1]), int(fields[2])
-            r, its, res = newton(W, q, mu, np.int64(nb), r0, tol, use_max, cfg.local_tolerance,
-                                 cfg.local_max_iterations, history)
+            r, its, _, _ = _newton(W, q, mu, np.int64(nb), r0, NEWTON_CAP, False, cfg, history)
             if _judged(W, q, mu, nb, r, tol, use_max)[1]:
                 return r, its
             start = r if fields[-1] == "from-newton" else r0
@@ -205,16 +199,15 @@ def run_candidate(name: str, cases, cfg) -> dict:
             return r, its + its2
         if name.startswith("newton>chain"):
             cap = int(name.split("-")[1]) if "-" in name else NEWTON_ITERATIONS
-            r, its, res = newton(W, q, mu, np.int64(nb), r0, tol, use_max, cfg.local_tolerance,
-                                 cfg.local_max_iterations, history, np.int64(cap))
+            r, its, _, _ = _newton(W, q, mu, np.int64(nb), r0, np.int64(cap), False, cfg,
+                                   history)
             if _judged(W, q, mu, nb, r, tol, use_max)[1]:
                 return r, its
             memory[0] = NO_NEWTON_FIRST
             r, its2, _, _ = solve(W, q, mu, np.int64(nb), r0, cfg, memory, history)
             return r, its + its2
         if name == "newton":
-            r, its, _ = newton(W, q, mu, np.int64(nb), r0, tol, use_max, cfg.local_tolerance,
-                               cfg.local_max_iterations, history)
+            r, its, _, _ = _newton(W, q, mu, np.int64(nb), r0, NEWTON_CAP, False, cfg, history)
             return r, its
         if name.startswith("proximal-"):
             r, _, its, _, _, _, _ = proximal_newton_dense(
@@ -230,8 +223,8 @@ def run_candidate(name: str, cases, cfg) -> dict:
             r, its, res = admm(W, q, mu, np.int64(nb), r0, tol, use_max,
                                np.int64(ADMM_ITERATIONS), POLISH_AT * math.sqrt(tol))
             if res > tol:
-                r, its2, _ = newton(W, q, mu, np.int64(nb), r, tol, use_max,
-                                    cfg.local_tolerance, cfg.local_max_iterations, history)
+                r, its2, _, _ = _newton(W, q, mu, np.int64(nb), r, NEWTON_CAP, False, cfg,
+                                        history)
                 its += its2
             return r, its
         raise SystemExit(f"unknown candidate {name!r}")
