@@ -155,6 +155,12 @@ class StepperSettings:
     max_impact_splits : int
         Most impacts localised within one step (>= 1); later ones in the step are taken by the
         classic scheme.
+    hybrid_last_sweeps : int
+        The sweeps of each of the ``hybrid`` chain's two last attempts, NSGS from zero and
+        from where its first NSGS stopped, after everything else failed (>= 1). Default 100:
+        at their former cap (``solver.max_iterations``, 10,000) they converged none of the
+        C-60's problems they ran on and took most of a coarse step's solve
+        (docs/reference-solver-speed.md, "Choosing the contact solve").
     proximal_rescue : float
         > 0: an attempt of the ``hybrid`` chain by proximal-point Newton from the warm start,
         after its Newton attempts (from NSGS's end, the warm start and zero) failed
@@ -177,6 +183,7 @@ class StepperSettings:
     length_scale: float = 1.0
     method: str = "hybrid"
     hybrid_sweeps: int = 100
+    hybrid_last_sweeps: int = 100
     restitution_threshold: float = 0.0
     joint_law: str = "midpoint"
     localise_impacts: bool = False
@@ -186,6 +193,9 @@ class StepperSettings:
     def __post_init__(self) -> None:
         if not self.time_step > 0.0:
             raise ValueError(f"time_step must be > 0, got {self.time_step!r}")
+        if not (isinstance(self.hybrid_last_sweeps, int) and self.hybrid_last_sweeps >= 1):
+            raise ValueError(f"hybrid_last_sweeps must be an integer >= 1, got "
+                             f"{self.hybrid_last_sweeps!r}")
         if not 0.5 <= self.theta <= 1.0:
             raise ValueError(f"theta must be in [0.5, 1], got {self.theta!r}")
         if self.activation not in RULES:
@@ -295,7 +305,7 @@ class MoreauJeanStepper:
             replace(solver, method=settings.method) if settings.method != "hybrid" else None,
             replace(solver, method="newton", max_iterations=200),
             replace(solver, method="nsgs", max_iterations=settings.hybrid_sweeps),
-            replace(solver, method="nsgs"),
+            replace(solver, method="nsgs", max_iterations=settings.hybrid_last_sweeps),
             replace(solver, method="newton", max_iterations=200, newton_direction="least_norm"))
         self._clusters(system)
         npair = system.pair_count
@@ -567,8 +577,9 @@ class MoreauJeanStepper:
         least-norm direction from there (redundant bearing rings: it converges where the
         regularised direction crawls, 7 of the 11 failed chains of c60-trip's first 6 ms), then
         Newton from the warm start, then from zero, then proximal-point Newton from the warm
-        start (weight ``proximal_rescue``, 0: skipped), then NSGS to its full cap from zero and
-        from where it stopped, keeping the first that converges (else the smallest residual).
+        start (weight ``proximal_rescue``, 0: skipped), then NSGS for ``hybrid_last_sweeps``
+        sweeps from zero and from where it stopped, keeping the first that converges (else the
+        smallest residual).
         The proximal attempt comes before the two NSGS attempts because on the C-60's
         rank-deficient problems they fail where it converges, after 20,000 sweeps
         (docs/reference-solver-speed.md);

@@ -112,8 +112,9 @@ def solve(w, q, mu, n_bilateral, r0, cfg, newton_first, history):
     if first == NO_NEWTON_FIRST or res_nsgs < best_residual:
         best_r, best_residual, best_ok = r_nsgs, res_nsgs, ok_nsgs
     # The attempts of the chain, in order (``MoreauJeanStepper._solve``): kind 0 regularised
-    # Newton, 1 least-norm Newton, 2 NSGS to its full cap, 3 proximal-point Newton (skipped
-    # when ``cfg.proximal_rescue`` is 0); start 0 NSGS's end, 1 the warm start, 2 zero.
+    # Newton, 1 least-norm Newton, 2 NSGS for ``hybrid_last_sweeps`` sweeps, 3 proximal-point
+    # Newton (skipped when ``cfg.proximal_rescue`` is 0); start 0 NSGS's end, 1 the warm
+    # start, 2 zero.
     kinds = (0, 1, 0, 0, 3, 2, 2)
     starts = (0, 0, 1, 2, 1, 2, 0)
     for a in range(7):
@@ -127,7 +128,7 @@ def solve(w, q, mu, n_bilateral, r0, cfg, newton_first, history):
                 cfg.local_max_iterations, history, PROXIMAL_OUTER)
         elif kinds[a] == 2:
             r, its, res, ok = _nsgs(csr, q, mu, n_bilateral, operator, start,
-                                    cfg.max_iterations, cfg, history)
+                                    cfg.hybrid_last_sweeps, cfg, history)
         else:
             r, its, res, ok = _newton(w, q, mu, n_bilateral, start, HYBRID_NEWTON_ITERATIONS,
                                       kinds[a] == 1, cfg, history)

@@ -68,6 +68,7 @@ class LoopSettings(NamedTuple):
     length_step: float              # finite-difference step of the spring stiffness [L]
     method: int                     # contact_solve.METHOD_*
     hybrid_sweeps: int
+    hybrid_last_sweeps: int         # StepperSettings.hybrid_last_sweeps
     restitution_threshold: float    # [L/T]
     midpoint_joints: bool
     tolerance: float
@@ -109,7 +110,7 @@ def compile_system(stepper) -> tuple[CompiledSystem, LoopSettings]:
         activation_margin=float(cfg.activation_margin),
         activation_rule=activation_rule(cfg), activation_hold=float(cfg.activation_hold),
         length_step=1e-6 * float(cfg.length_scale), method=METHOD_CODES[cfg.method],
-        hybrid_sweeps=int(cfg.hybrid_sweeps),
+        hybrid_sweeps=int(cfg.hybrid_sweeps), hybrid_last_sweeps=int(cfg.hybrid_last_sweeps),
         restitution_threshold=float(cfg.restitution_threshold),
         midpoint_joints=cfg.joint_law == "midpoint", tolerance=float(solver.tolerance),
         use_max=bool(solver.use_max_normalisation), max_iterations=int(solver.max_iterations),
@@ -126,4 +127,4 @@ def compile_system(stepper) -> tuple[CompiledSystem, LoopSettings]:
 
 def history_length(settings: LoopSettings) -> int:
     """Length of the solvers' residual-history scratch: at least every iteration cap."""
-    return max(settings.max_iterations, settings.hybrid_sweeps, 200)
+    return max(settings.max_iterations, settings.hybrid_sweeps, settings.hybrid_last_sweeps, 200)

@@ -1,0 +1,91 @@
+"""The hybrid chain's two last attempts (NSGS from zero and from its first NSGS's end) run for
+``StepperSettings.hybrid_last_sweeps`` sweeps, in both step loops.
+
+On the C-60 problem that every other attempt of the chain leaves unconverged (the fixture of
+``test_proximal_rescue.py``: ``c60-trip``'s step 16240 at 1 us, rank 43 of 52 rows; the
+proximal rescue turned off so that the chain reaches its last attempts), neither cap converges
+it, and the run pays the cap: that is the measured reason of the default of 100
+(docs/reference-solver-speed.md, "Choosing the contact solve on recorded problems").
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from clearbench.adapters.base import RunSettings
+from clearbench.adapters.options import OptionError
+from clearbench.adapters.reference.build import build
+from clearbench.adapters.reference.engine import create
+from clearbench.ref_solver.compiled.contact_solve import NO_NEWTON_FIRST, solve
+from clearbench.ref_solver.compiled.system_arrays import compile_system, history_length
+from clearbench.ref_solver.contact_problem import ContactProblem
+from clearbench.ref_solver.fc3d_residual import natural_map_residual
+from clearbench.ref_solver.stepper import StepperSettings
+from clearbench.scenarios.library import get_scene
+
+FIXTURE = Path(__file__).parent / "data" / "c60_trip_unconverged_problem.npz"
+#: The reference's default tolerance on the relative natural-map residual.
+TOLERANCE = 1e-12
+
+
+@pytest.fixture(scope="module")
+def problem():
+    with np.load(FIXTURE) as data:
+        return (ContactProblem(data["W"], data["q"], data["mu"], int(data["n_bilateral"])),
+                data["r0"].copy())
+
+
+def _stepper(last_sweeps: int | None):
+    scene = get_scene("pendulum")  # _solve reads only the settings
+    options = {"proximal_rescue": 0.0}
+    if last_sweeps is not None:
+        options["hybrid_last_sweeps"] = last_sweeps
+    settings = create("default").run_settings(scene, RunSettings(options=options))
+    return build(scene, settings, python_step=False).stepper
+
+
+def _compiled(stepper, contact_problem, r0):
+    _, settings = compile_system(stepper)
+    return solve(np.asarray(contact_problem.W), contact_problem.q, contact_problem.mu,
+                 np.int64(contact_problem.n_bilateral), r0, settings,
+                 np.array([NO_NEWTON_FIRST], dtype=np.int64),
+                 np.empty(history_length(settings)))
+
+
+def test_the_default_is_100_and_the_option_sets_it():
+    assert _stepper(None).settings.hybrid_last_sweeps == 100
+    assert _stepper(10_000).settings.hybrid_last_sweeps == 10_000
+
+
+@pytest.mark.parametrize("value", [0, -5, 2.5])
+def test_a_bad_cap_is_refused_naming_the_option(value):
+    with pytest.raises(OptionError, match="hybrid_last_sweeps"):
+        create("default").run_settings(get_scene("pendulum"), RunSettings(
+            options={"hybrid_last_sweeps": value}))
+    with pytest.raises(ValueError, match="hybrid_last_sweeps"):
+        StepperSettings(time_step=1e-3, hybrid_last_sweeps=value)
+
+
+def test_both_loops_run_the_last_attempts_to_the_cap(problem):
+    """With the cap at 100 against 10,000 the chain costs 2 x 9,900 sweeps fewer at most and
+    leaves the problem unconverged either way (checked by the residual evaluated again);
+    both step loops agree on the iterations."""
+    contact_problem, r0 = problem
+    iterations = {}
+    for cap in (100, 10_000):
+        stepper = _stepper(cap)
+        python = stepper._solve(contact_problem, r0)
+        r, compiled_iterations, _, converged = _compiled(stepper, contact_problem, r0)
+        assert not python.converged and not converged
+        for result in (python.r, r):
+            residual = natural_map_residual(contact_problem.W, contact_problem.q,
+                                            contact_problem.mu, result,
+                                            contact_problem.n_bilateral)
+            assert residual > TOLERANCE
+        assert python.iterations == compiled_iterations
+        iterations[cap] = compiled_iterations
+    # Both NSGS attempts run to their cap here (neither converges): the difference is theirs.
+    assert iterations[10_000] - iterations[100] == 2 * (10_000 - 100)
