@@ -26,9 +26,10 @@ from 8e-3 to 2e-5),
 ``roundoff_floor``, ``step_loop`` (``auto``, ``python`` or ``compiled``: :mod:`.run`) and
 ``proximal_rescue`` (default 1e-8: an attempt of the hybrid chain by proximal-point Newton
 when its Newton attempts (from NSGS's end, the warm start and zero) failed, its weight
-relative to W's largest diagonal entry, ref_solver/fc3d_proximal.py; 0: off) and
+relative to W's largest diagonal entry, ref_solver/fc3d_proximal.py; 0: off),
 ``hybrid_last_sweeps`` (default 100: the sweeps of each of the hybrid chain's two last NSGS
-attempts, after everything else failed; ``max_iterations`` is the ``nsgs`` method's cap); see
+attempts, after everything else failed; ``max_iterations`` is the ``nsgs`` method's cap) and
+``max_projection_iterations`` (default 100, the projection's Gauss–Newton cap); see
 :class:`~clearbench.ref_solver.stepper.StepperSettings`.
 """
 
@@ -74,6 +75,7 @@ OPTIONS = OptionTable("reference", (
     choice("step_loop", ("auto", "python", "compiled")),
     number("proximal_rescue", at_least=0.0),
     integer("hybrid_last_sweeps", at_least=1),
+    integer("max_projection_iterations", at_least=1),
 ))
 OPTION_NAMES = OPTIONS.names
 
@@ -118,6 +120,7 @@ def stepper_settings(preset: str, scene: Scene, settings: RunSettings) -> Steppe
         localise_impacts=options["localise_impacts"],
         proximal_rescue=float(options.get("proximal_rescue", DEFAULT_RELATIVE_WEIGHT)),
         hybrid_last_sweeps=int(options.get("hybrid_last_sweeps", 100)),
+        max_projection_iterations=int(options.get("max_projection_iterations", 100)),
         # Bounces slower than two steps' worth of gravity cannot be resolved by the fixed
         # step; they are taken as plastic so that bodies come to rest (see StepperSettings).
         restitution_threshold=float(options.get(
