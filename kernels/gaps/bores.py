@@ -136,14 +136,19 @@ def _cylinder_end_in_bore(end, direction, centre, reach, journal_position, journ
         rim_point = (stage[index, 1, 0], stage[index, 1, 1], stage[index, 1, 2])
         stage_contact(stage, index, gap, axpy(-gap, normal, rim_point), normal)
         # A tilted journal's own end rim can be inside the bore there while its axis runs
-        # beyond: that rim against the bore's solid, its ends read, where it is nearer.
-        own = np.empty((1, 3, 3))
-        _ring_in_bore(axpy(direction * end * journal_half_length, column_of(journal_rotation, 2),
-                           journal_position), journal_rotation, journal_radius, 0.0, TWO_PI,
-                      False, bore_position, bore_rotation, bore_radius, bore_half_length,
-                      bore_start, bore_span, bore_depth, True, not in_hole, 0, own)
-        if own[0, 2, 0] < gap:
-            copy_staged_from(own, stage, index)
+        # beyond: that rim against the bore's solid, its ends read, where it is nearer. A rim
+        # wholly beyond the bore's end (its points reach r sin(tilt) along the bore's axis)
+        # is not.
+        axis_j = column_of(journal_rotation, 2)
+        rim_centre = axpy(direction * end * journal_half_length, axis_j, journal_position)
+        tilt_reach = journal_radius * math.sqrt(max(0.0, 1.0 - dot(axis_j, axis_b) ** 2))
+        if end * dot(sub(rim_centre, bore_position), axis_b) - tilt_reach < bore_half_length:
+            own = np.empty((1, 3, 3))
+            _ring_in_bore(rim_centre, journal_rotation, journal_radius, 0.0, TWO_PI, False,
+                          bore_position, bore_rotation, bore_radius, bore_half_length,
+                          bore_start, bore_span, bore_depth, True, not in_hole, 0, own)
+            if own[0, 2, 0] < gap:
+                copy_staged_from(own, stage, index)
         return in_hole or within_depth(bore_depth, stage, index)
     rim_position = axpy(direction * end * journal_half_length, column_of(journal_rotation, 2),
                         journal_position)
