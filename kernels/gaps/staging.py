@@ -28,3 +28,11 @@ def copy_staged(stage, source, target):
 def within_depth(depth, stage, k):
     """False if the staged contact ``k`` lies deeper than ``depth`` (> 0; 0: no bound)."""
     return not (depth > 0.0 and stage[k, 2, 0] < -depth)
+
+
+@njit(cache=True, inline="always")
+def copy_staged_from(source_stage, target_stage, target):
+    """Copy the staged contact of ``source_stage[0]`` (a scratch stage) to slot ``target``."""
+    for i in range(3):
+        for j in range(3):
+            target_stage[target, i, j] = source_stage[0, i, j]
