@@ -11,22 +11,17 @@ tolerance 1e-12 (the best, Newton from the warm start, at 4.9e-8 after its 200 i
 from __future__ import annotations
 
 from dataclasses import replace
-from pathlib import Path
 
-import numpy as np
 import pytest
 
 from clearbench.adapters.base import RunSettings
 from clearbench.adapters.options import OptionError
-from clearbench.adapters.reference.build import build
 from clearbench.adapters.reference.engine import create
-from clearbench.ref_solver.compiled.contact_solve import NO_NEWTON_FIRST, solve
-from clearbench.ref_solver.compiled.system_arrays import compile_system, history_length
-from clearbench.ref_solver.contact_problem import ContactProblem
 from clearbench.ref_solver.fc3d_residual import natural_map_residual
 from clearbench.scenarios.library import get_scene
 
-FIXTURE = Path(__file__).parent / "data" / "c60_trip_unconverged_problem.npz"
+from .unconverged_problem import compiled_solve, load_problem, reference_stepper
+
 #: The chain's tolerance on the relative natural-map residual (the reference's default).
 TOLERANCE = 1e-12
 #: The relative proximal weight measured on c60-trip's four unconverged problems (2-4 outer
@@ -36,18 +31,12 @@ WEIGHT = 1e-8
 
 @pytest.fixture(scope="module")
 def problem():
-    with np.load(FIXTURE) as data:
-        return (ContactProblem(data["W"], data["q"], data["mu"], int(data["n_bilateral"])),
-                data["r0"].copy())
+    return load_problem()
 
 
 def _stepper(weight: float):
-    """A reference stepper with the default preset and ``proximal_rescue`` = ``weight`` (its
-    system is any scene's: ``_solve`` reads only the settings)."""
-    scene = get_scene("pendulum")
-    settings = create("default").run_settings(scene, RunSettings(
-        options={"proximal_rescue": weight}))
-    return build(scene, settings, python_step=False).stepper
+    """A reference stepper with the default preset and ``proximal_rescue`` = ``weight``."""
+    return reference_stepper(proximal_rescue=weight)
 
 
 @pytest.mark.parametrize("weight", [0.0, WEIGHT])
@@ -67,11 +56,7 @@ def test_the_python_chain_converges_with_the_rescue_only(problem, weight):
 @pytest.mark.parametrize("weight", [0.0, WEIGHT])
 def test_the_compiled_chain_converges_with_the_rescue_only(problem, weight):
     contact_problem, r0 = problem
-    system, settings = compile_system(_stepper(weight))
-    r, _, residual, converged = solve(
-        np.asarray(contact_problem.W), contact_problem.q, contact_problem.mu,
-        np.int64(contact_problem.n_bilateral), r0, settings,
-        np.array([NO_NEWTON_FIRST], dtype=np.int64), np.empty(history_length(settings)))
+    r, _, residual, converged = compiled_solve(_stepper(weight), contact_problem, r0)
     independent = natural_map_residual(contact_problem.W, contact_problem.q,
                                        contact_problem.mu, r, contact_problem.n_bilateral)
     assert converged == (weight > 0.0)

@@ -3,7 +3,7 @@ from zero and from its first NSGS's end) run for ``StepperSettings.hybrid_last_s
 in both step loops; the projection's Gauss–Newton stops at ``max_projection_iterations``.
 
 On the C-60 problem that every other attempt of the chain leaves unconverged (the fixture of
-``test_proximal_rescue.py``: ``c60-trip``'s step 16240 at 1 us, rank 43 of 52 rows; the
+``tests/unconverged_problem.py``: ``c60-trip``'s step 16240 at 1 us, rank 43 of 52 rows; the
 proximal rescue turned off so that the chain reaches its last attempts), neither cap converges
 it, and the run pays the cap: that is the measured reason of the default of 100
 (docs/reference-solver-speed.md, "Choosing the contact solve on recorded problems").
@@ -11,50 +11,33 @@ it, and the run pays the cap: that is the measured reason of the default of 100
 
 from __future__ import annotations
 
-from pathlib import Path
-
-import numpy as np
 import pytest
 
 from clearbench.adapters.base import RunSettings
 from clearbench.adapters.options import OptionError
-from clearbench.adapters.reference.build import build
 from clearbench.adapters.reference.engine import create
 from clearbench.harness.measure import series
-from clearbench.ref_solver.compiled.contact_solve import NO_NEWTON_FIRST, solve
-from clearbench.ref_solver.compiled.system_arrays import compile_system, history_length
-from clearbench.ref_solver.contact_problem import ContactProblem
+from clearbench.ref_solver.compiled.system_arrays import compile_system
 from clearbench.ref_solver.fc3d_residual import natural_map_residual
 from clearbench.ref_solver.stepper import StepperSettings
 from clearbench.scenarios.library import get_scene
 
-FIXTURE = Path(__file__).parent / "data" / "c60_trip_unconverged_problem.npz"
+from .unconverged_problem import compiled_solve, load_problem, reference_stepper
+
 #: The reference's default tolerance on the relative natural-map residual.
 TOLERANCE = 1e-12
 
 
 @pytest.fixture(scope="module")
 def problem():
-    with np.load(FIXTURE) as data:
-        return (ContactProblem(data["W"], data["q"], data["mu"], int(data["n_bilateral"])),
-                data["r0"].copy())
+    return load_problem()
 
 
 def _stepper(last_sweeps: int | None, **options):
-    scene = get_scene("pendulum")  # _solve reads only the settings
     options = {"proximal_rescue": 0.0, **options}
     if last_sweeps is not None:
         options["hybrid_last_sweeps"] = last_sweeps
-    settings = create("default").run_settings(scene, RunSettings(options=options))
-    return build(scene, settings, python_step=False).stepper
-
-
-def _compiled(stepper, contact_problem, r0):
-    _, settings = compile_system(stepper)
-    return solve(np.asarray(contact_problem.W), contact_problem.q, contact_problem.mu,
-                 np.int64(contact_problem.n_bilateral), r0, settings,
-                 np.array([NO_NEWTON_FIRST], dtype=np.int64),
-                 np.empty(history_length(settings)))
+    return reference_stepper(**options)
 
 
 CAPS = pytest.mark.parametrize("name", ["hybrid_last_sweeps", "max_projection_iterations"])
@@ -87,7 +70,7 @@ def test_both_loops_run_the_last_attempts_to_the_cap(problem):
     for cap in (100, 10_000):
         stepper = _stepper(cap)
         python = stepper._solve(contact_problem, r0)
-        r, compiled_iterations, _, converged = _compiled(stepper, contact_problem, r0)
+        r, compiled_iterations, _, converged = compiled_solve(stepper, contact_problem, r0)
         assert not python.converged and not converged
         for result in (python.r, r):
             residual = natural_map_residual(contact_problem.W, contact_problem.q,

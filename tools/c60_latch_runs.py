@@ -27,6 +27,7 @@ import numpy as np
 from clearbench.adapters.base import RunSettings
 from clearbench.adapters.reference import create
 from clearbench.harness.c60.analysis import settled_outputs, trip_events
+from clearbench.harness.cli.common import add_engine_options_option, engine_options
 from clearbench.harness.measure import series
 from clearbench.scenarios.library import get_scene
 
@@ -76,14 +77,10 @@ def main() -> None:
     parser.add_argument("--horizon", type=float, default=None, help="[ms] (default: scene's)")
     parser.add_argument("--record-every-ms", type=float, default=0.01,
                         help="recording interval [ms]")
-    parser.add_argument("--option", action="append", default=[], metavar="KEY=NUMBER",
-                        help="a numeric run option of the reference engine, e.g. "
-                             "proximal_rescue=0 (the rescue off)")
+    add_engine_options_option(parser, "a run option of the reference engine (as `clearbench "
+                              "run --option`), e.g. proximal_rescue=0 (the rescue off)")
     args = parser.parse_args()
-    options = {}
-    for item in args.option:
-        key, _, value = item.partition("=")
-        options[key] = float(value)
+    options = engine_options(args)
     for scene_name in args.scene:
         for variant in args.variant or ["source"]:
             for time_step in args.dt:

@@ -119,8 +119,9 @@ def stepper_settings(preset: str, scene: Scene, settings: RunSettings) -> Steppe
         joint_law=str(options.get("joint_law", "midpoint")),
         localise_impacts=options["localise_impacts"],
         proximal_rescue=float(options.get("proximal_rescue", DEFAULT_RELATIVE_WEIGHT)),
-        hybrid_last_sweeps=int(options.get("hybrid_last_sweeps", 100)),
-        max_projection_iterations=int(options.get("max_projection_iterations", 100)),
+        # The iteration caps: StepperSettings' own defaults unless set.
+        **{cap: int(options[cap]) for cap in ("hybrid_last_sweeps", "max_projection_iterations")
+           if cap in options},
         # Bounces slower than two steps' worth of gravity cannot be resolved by the fixed
         # step; they are taken as plastic so that bodies come to rest (see StepperSettings).
         restitution_threshold=float(options.get(
