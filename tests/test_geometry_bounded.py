@@ -273,14 +273,24 @@ def test_journal_in_bore_contacts_at_the_ends_of_the_overlap(gap0):
     gap, point_a, point_b, _ = contacts(G.CYLINDER, params(1.0, 1.0), (e, 0.0, 0.8), IDENTITY,
                                         *bore)
     assert gap.shape == (2,) and np.allclose(np.sort(point_b[:, 2]), [-0.2, 1.0], atol=HAND)
-    # Entirely out, 0.5 beyond the bore's end: one candidate, its lower rim (radius 1 about
-    # x = e, at z = 1.5) against the bore's solid. Its point farthest from the axis, at radius
-    # 1.3 - gap0, is nearest the end rim (radius 1.3, z = 1) when over the hole (gap0 > 0), and
-    # over the end face, 0.5 above it, otherwise.
+    # Entirely out, 0.5 beyond the bore's end. First candidate: the journal's lower rim (radius
+    # 1 about x = e, at z = 1.5) against the bore's solid. Its point farthest from the axis, at
+    # radius 1.3 - gap0, is nearest the end rim (radius 1.3, z = 1) when over the hole
+    # (gap0 > 0), and over the end face, 0.5 above it, otherwise. Second: the bore's end rim
+    # against the journal's solid, nearest at the journal's end face's point above the rim's
+    # point (1.3, 0, 1): the first's point when gap0 >= 0 (the same contact, given once), else
+    # a second point of the end face's overlap with the annulus, 0.5 above it.
     gap, point_a, _, frame = contacts(G.CYLINDER, params(1.0, 0.5), (e, 0.0, 2.0), IDENTITY,
                                       *bore)
-    assert gap.shape == (1,) and abs(gap[0] - math.hypot(max(gap0, 0.0), 0.5)) < HAND
-    assert np.allclose(point_a[0], [1.3 - gap0, 0.0, 1.5], atol=HAND)
+    first = math.hypot(max(gap0, 0.0), 0.5)
+    if gap0 >= 0.0:
+        assert gap.shape == (1,) and abs(gap[0] - first) < HAND
+        assert np.allclose(point_a[0], [1.3 - gap0, 0.0, 1.5], atol=HAND)
+    else:
+        assert gap.shape == (2,) and np.all(np.abs(gap - 0.5) < HAND)
+        assert np.allclose(np.sort(point_a[:, 0]), [1.3, 1.3 - gap0], atol=HAND)
+        assert np.allclose(point_a[:, 2], 1.5, atol=HAND)
+        assert np.allclose(frame[:, 0], [[0, 0, -1], [0, 0, -1]], atol=HAND)
 
 
 def test_tilted_journal_touches_at_the_overlap_ends_as_dense_sampling_says():

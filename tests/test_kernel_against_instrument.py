@@ -9,9 +9,17 @@ or closest, boundary point of one shape to the other's solid) lies in [gap - res
 The kernel's figure is its smallest candidate gap (+inf without a candidate). What must hold,
 give or take TOLERANCE (round-off, and the kernel's minimisation over a ring's angle):
 
-- EXACT pairs (a plane against anything, a ring or arc against a face, a cylinder or a bore):
-  the kernel's candidates are boundary points with their exact signed distances and its
-  smallest is G: it lies in [gap - resolution, gap].
+- EXACT pairs (a plane against anything, a ring or arc against a cylinder or a bore): the
+  kernel's candidates are boundary points with their exact signed distances and its smallest
+  is G: it lies in [gap - resolution, gap].
+- RING_FACE pairs (a ring or arc against a rectangle or disc): separated or touching, as
+  EXACT. Penetrating, the kernel measures a ring below the face's plane within the face's bound
+  from the face (the push back through it; where the ring crosses the bound, the ring against
+  the face's edge along their common normal, docs/contact-geometry.md), not from the face's
+  lateral bound where that exit is nearer: a contact patch's bound is not a surface of the
+  part. So it sees at least the witnessed penetration, and is no deeper than the ring's deepest
+  point below the face's plane within its bound (:func:`_face_push`, computed here from the
+  ring's exact points, not by the kernel): a phantom is still caught.
 - SEPARATION pairs (two solids: spheres, boxes, capsules, a sphere against a face's slab, a
   journal in a bore): the kernel's gap is a separation distance, the translation
   that parts the two solids. Separated, that is their distance, G; overlapping it is at least
@@ -65,7 +73,7 @@ THOROUGH_EXAMPLES = 150
 TOLERANCE = 1e-8
 
 #: Pairs, canonical order (A, B) as the kernel computes them, and what is asserted.
-EXACT, SEPARATION, RIMS = "exact", "separation", "rims"
+EXACT, SEPARATION, RIMS, RING_FACE = "exact", "separation", "rims", "ring_face"
 PAIRS = {
     ("plane", "sphere"): EXACT, ("plane", "box"): EXACT, ("plane", "capsule"): EXACT,
     ("plane", "cylinder"): EXACT, ("plane", "circle"): EXACT, ("plane", "arc"): EXACT,
@@ -74,9 +82,9 @@ PAIRS = {
     ("box", "box"): SEPARATION, ("capsule", "capsule"): SEPARATION,
     ("circle", "cylinder"): EXACT, ("arc", "cylinder"): EXACT,
     ("rectangle", "sphere"): SEPARATION, ("rectangle", "cylinder"): RIMS,
-    ("rectangle", "circle"): EXACT, ("rectangle", "arc"): EXACT,
+    ("rectangle", "circle"): RING_FACE, ("rectangle", "arc"): RING_FACE,
     ("disc", "sphere"): SEPARATION, ("disc", "cylinder"): RIMS,
-    ("disc", "circle"): EXACT, ("disc", "arc"): EXACT,
+    ("disc", "circle"): RING_FACE, ("disc", "arc"): RING_FACE,
     ("circle", "bore"): EXACT, ("arc", "bore"): EXACT, ("cylinder", "bore"): SEPARATION,
 }
 ORDERED = [(pair, swapped) for pair in PAIRS for swapped in (False, True)]
@@ -233,8 +241,93 @@ def configurations(draw, pair):
     return shape_a, (position_a, quaternion_a), shape_b, (position_b, quaternion_b)
 
 
+#: Samples of a ring's angle locating where it crosses a face's bound (then bisected).
+_CROSSING_SAMPLES = 2048
+#: Bisections of a crossing: its angle to 2 pi / 2048 / 2^50, far below round-off of the depth
+#: (also the golden-section steps of a touching point: 0.618^50 = 3e-11 of two samples).
+_CROSSING_BISECTIONS = 50
+#: The golden section, (sqrt 5 - 1) / 2.
+_GOLDEN = 0.5 * (math.sqrt(5.0) - 1.0)
+
+
+def _world_points(shape, pose, local) -> np.ndarray:
+    """Points given in ``shape``'s frame [L] (n, 3) in the world, the shape on its body."""
+    offset = np.asarray(shape.position, dtype=float)
+    turn = np.asarray(shape.orientation, dtype=float)
+    return np.array([pose[0] + _rotate(pose[1], offset + _rotate(turn, p)) for p in local])
+
+
+def _face_push(face, face_pose, ring, ring_pose) -> float:
+    """The depth [L] of the ring's deepest point below the face's plane among its points within
+    the face's bound (at most the face's ``depth``), 0 if none is below it: the most a contact
+    measured from the face can read. Exact up to round-off: over each stretch of the ring's
+    angle within the bound the height's minimum is at the ring's lowest point or at the
+    stretch's ends (an arc's end, a crossing of the bound found by bisection, or a point where
+    the ring touches the bound from outside, found by golden-section search)."""
+    start = getattr(ring, "start_angle", 0.0)
+    end = getattr(ring, "end_angle", 2.0 * math.pi)
+
+    def in_face_frame(angles):
+        local = np.c_[ring.radius * np.cos(angles), ring.radius * np.sin(angles),
+                      np.zeros(len(angles))]
+        world = _world_points(ring, ring_pose, local)
+        origin = _world_points(face, face_pose, np.zeros((1, 3)))[0]
+        turn = _multiply(face_pose[1], np.asarray(face.orientation, dtype=float))
+        back = turn * np.array([1.0, -1.0, -1.0, -1.0])
+        return np.array([_rotate(back, w - origin) for w in world])
+
+    def beyond(points):  # how far beyond the face's bound [L] (<= 0: within it)
+        if face.kind == "disc":
+            return np.hypot(points[:, 0], points[:, 1]) - face.radius
+        return np.max(np.abs(points[:, :2]) - np.asarray(face.half_extents), axis=1)
+
+    def within(points):  # on the bound to round-off counts as within, as in the kernel
+        return beyond(points) <= TOLERANCE
+
+    samples = np.linspace(start, end, _CROSSING_SAMPLES + 1)
+    outside = beyond(in_face_frame(samples))
+    inside = outside <= TOLERANCE
+    angles = [start, end]
+    # Where the ring touches the bound from outside without crossing it: the local minima of
+    # its distance beyond the bound, refined by golden-section search between the samples
+    # either side.
+    for i in np.flatnonzero((outside[1:-1] <= outside[:-2]) & (outside[1:-1] <= outside[2:])):
+        low, high = samples[i], samples[i + 2]
+        for _ in range(_CROSSING_BISECTIONS):
+            left, right = high - _GOLDEN * (high - low), low + _GOLDEN * (high - low)
+            if beyond(in_face_frame([left]))[0] <= beyond(in_face_frame([right]))[0]:
+                high = right
+            else:
+                low = left
+        angles.append(0.5 * (low + high))
+    for i in np.flatnonzero(inside[:-1] != inside[1:]):
+        low, high = samples[i], samples[i + 1]
+        for _ in range(_CROSSING_BISECTIONS):
+            middle = 0.5 * (low + high)
+            if within(in_face_frame([middle]))[0] == inside[i]:
+                low = middle
+            else:
+                high = middle
+        angles += [low if inside[i] else high]
+    # The ring's lowest point: its height z(theta) = c + a cos(theta) + b sin(theta) is least
+    # at atan2(-b, -a), taken into the arc's range (a flat ring has none: its ends and
+    # crossings are enough).
+    zero, quarter, half = in_face_frame([0.0, 0.5 * math.pi, math.pi])[:, 2]
+    a, b = 0.5 * (zero - half), quarter - 0.5 * (zero + half)
+    if math.hypot(a, b) > 0.0:
+        lowest = start + (math.atan2(-b, -a) - start) % (2.0 * math.pi)
+        if lowest <= end:
+            angles.append(lowest)
+    points = in_face_frame(np.array(angles))
+    depth = float(np.max(-points[within(points), 2], initial=0.0))
+    if face.depth is not None:
+        depth = min(depth, face.depth)
+    return max(depth, 0.0)
+
+
 def _check(pair, swapped, configuration):
     shape_a, pose_a, shape_b, pose_b = configuration
+    push = _face_push(*configuration) if PAIRS[pair] == RING_FACE else 0.0
     if swapped:
         shape_a, pose_a, shape_b, pose_b = shape_b, pose_b, shape_a, pose_a
     kernel = contacts_between(shape_a, pose_a, shape_b, pose_b)
@@ -246,8 +339,12 @@ def _check(pair, swapped, configuration):
     no_phantom = smallest >= lower - TOLERANCE
     report = (f"kernel's smallest gap {smallest!r}, instrument's {reading.gap!r} "
               f"(true value in [{lower!r}, {reading.gap!r}])")
-    if what == EXACT:
+    if what == EXACT or (what == RING_FACE and lower > 0.0):
         assert seen and no_phantom, report
+    elif what == RING_FACE:
+        assert seen, "the kernel misses a penetration or contact: " + report
+        assert smallest >= min(lower, -push) - TOLERANCE, (
+            f"deeper than the ring's deepest point below the face ({push!r}): " + report)
     elif what == SEPARATION:
         assert seen, "the kernel misses a penetration or contact: " + report
         if lower > 0.0:

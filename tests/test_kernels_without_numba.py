@@ -136,7 +136,10 @@ def _compare_with_compiled(plain: dict[str, np.ndarray]) -> None:
     # the ring's angle found by Brent's search (kernels/gaps/ring_faces.py) or golden-section
     # search (kernels/gaps/round_solids.py), where the gap is quadratic in the angle, so the
     # minimum's position is fixed by the gap's round-off only to sqrt(eps) ~ 1.5e-8 of the
-    # radius (<= 0.3 m here): 1e-8 m for those points. Their gaps keep 1e-12 (the gap is flat
+    # radius (<= 0.3 m here): 1e-8 m for those points. The same holds for a journal in a bore
+    # (kernels/gaps/bores.py), whose candidates past a bore's edge or across a partial bore's
+    # cut are minima over a ring's angle and a golden-section search over height or along an
+    # edge. Their gaps keep 1e-12 (the gap is flat
     # there to second order); their frames, past a face's edge the direction from the edge to
     # the point, turn by at most the point's difference over the gap: 1e-8 m / |gap| (|gap|
     # taken no smaller than 1e-4 m).
@@ -146,7 +149,8 @@ def _compare_with_compiled(plain: dict[str, np.ndarray]) -> None:
     ring_face = {gaps.CIRCLE, gaps.ARC}, {gaps.RECTANGLE, gaps.DISC, gaps.BORE}
     for i in range(count.size):
         pair = set(int(k) for k in kinds[i])
-        minima = bool(pair & ring_face[0]) and bool(pair & ring_face[1])
+        minima = (bool(pair & ring_face[0]) and bool(pair & ring_face[1])
+                  or pair == {gaps.CYLINDER, gaps.BORE})
         smallest_gap = max(float(np.min(np.abs(compiled["gap"][i, :count[i]]), initial=1.0)),
                            1e-4)
         frame_bound = 1e-12 + 1e-8 / smallest_gap if minima else 1e-12

@@ -47,6 +47,12 @@ from clearbench.kernels.jit import njit
 EDGE_GOLDEN_STEPS = 80
 #: Golden-section steps along a partial bore's axis (:func:`_surface_in_journal`).
 SURFACE_GOLDEN_STEPS = 40
+#: Two candidates of a journal beside its bore whose points on the journal lie within this
+#: fraction of the journal's radius are one contact (the bore's end rim met at the journal's
+#: own rim): the second is not kept, so a solver is not given the same contact twice. Far above
+#: the two searches' agreement (1e-12 of the radius where both are closed forms, about 1e-9
+#: where one is a golden-section minimum), far below any distance between distinct contacts.
+SAME_CONTACT = 1e-6
 
 
 @njit(cache=True, inline="always")
@@ -343,7 +349,8 @@ def _cylinder_in_bore(journal_position, journal_rotation, journal_radius, journa
     (:func:`_ring_in_bore`), so a journal pushed along its axis onto the bore's end face (or,
     off centre, onto its rim) is seen before it enters the hole; slot 1 is the bore's edges
     against the journal's solid (:func:`_bore_edges_in_journal`: its end rim against the
-    journal's lateral surface, tilted or beside the hole)."""
+    journal's lateral surface, tilted or beside the hole), not kept where it is slot 0's contact
+    (its point within SAME_CONTACT of the journal's radius of slot 0's)."""
     axis_b = column_of(bore_rotation, 2)
     axis_j = column_of(journal_rotation, 2)
     direction = 1.0 if dot(axis_j, axis_b) >= 0.0 else -1.0
@@ -364,7 +371,11 @@ def _cylinder_in_bore(journal_position, journal_rotation, journal_radius, journa
             bore_position, bore_rotation, bore_radius, bore_half_length, bore_start, bore_span,
             bore_depth)
         stage_contact(stage, 1, edge, point, normal)
-        return 2, within_depth(bore_depth, stage, 0), True
+        kept_0 = within_depth(bore_depth, stage, 0)
+        apart = math.sqrt((stage[1, 1, 0] - stage[0, 1, 0]) ** 2
+                          + (stage[1, 1, 1] - stage[0, 1, 1]) ** 2
+                          + (stage[1, 1, 2] - stage[0, 1, 2]) ** 2)
+        return 2, kept_0, not kept_0 or apart > SAME_CONTACT * journal_radius
     local = to_local(bore_position, bore_rotation, journal_position)
     in_hole = math.hypot(local[0], local[1]) < bore_radius
     kept_0 = _cylinder_end_in_bore(-1.0, direction, centre, reach, journal_position,
