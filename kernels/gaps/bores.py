@@ -218,7 +218,9 @@ def _bore_edges_in_journal(journal_position, journal_rotation, journal_radius,
                            journal_half_length, bore_position, bore_rotation, bore_radius,
                            bore_half_length, bore_start, bore_span, bore_depth):
     """The point of the bore's edges (its two end rims, circles or arcs, and a partial bore's
-    two cut edges at its radius) of smallest signed distance to the journal's solid: (distance
+    two cut edges at its radius; for a bore with a back also the back's end rims, the cut edges
+    at the back's radius and the cut faces' radial edges at the ends) of smallest signed
+    distance to the journal's solid: (distance
     [L], point on the journal's surface (world), unit normal from the journal toward that edge
     point (world), the edge point's z in the bore's frame [L]). The journal's end rims (the
     other candidates) do not see these where the journal's lateral surface or end face lies
@@ -231,15 +233,19 @@ def _bore_edges_in_journal(journal_position, journal_rotation, journal_radius,
     is_arc = bore_span < TWO_PI
     e1 = rotate_back(journal_rotation, column_of(bore_rotation, 0))
     e2 = rotate_back(journal_rotation, column_of(bore_rotation, 1))
+    # A bore with a back has a second rim at each end, the back's (radius + depth).
+    rims = 2 if bore_depth > 0.0 else 1
     for end in (-1.0, 1.0):
         rim_centre = to_local(journal_position, journal_rotation,
                               axpy(end * bore_half_length, axis_b, bore_position))
-        _, distance, point, gradient = ring_solid_minimum(
-            CYLINDER_SOLID, rim_centre, e1, e2, bore_radius, bore_start, bore_span, is_arc,
-            journal_radius, journal_half_length, 0.0, 0.0, 0.0)
-        if distance < best:
-            best, best_local, best_gradient, best_z = distance, point, gradient, \
-                end * bore_half_length
+        for which in range(rims):
+            r = bore_radius + which * bore_depth
+            _, distance, point, gradient = ring_solid_minimum(
+                CYLINDER_SOLID, rim_centre, e1, e2, r, bore_start, bore_span, is_arc,
+                journal_radius, journal_half_length, 0.0, 0.0, 0.0)
+            if distance < best:
+                best, best_local, best_gradient, best_z = distance, point, gradient, \
+                    end * bore_half_length
     axis_j = column_of(journal_rotation, 2)
     for end in (-1.0, 1.0):
         # Where the journal's axis crosses the plane of this end face, if that point is on
@@ -264,18 +270,30 @@ def _bore_edges_in_journal(journal_position, journal_rotation, journal_radius,
             best, best_local, best_gradient, best_z = distance, point, gradient, \
                 end * bore_half_length
     if is_arc:
+        # The cut edges along the axis (at the radius, and at the back's for a bore with one)
+        # and, for a bore with a back, the cut face's radial edges at the ends.
         for angle in (bore_start, bore_start + bore_span):
-            radial = (bore_radius * math.cos(angle), bore_radius * math.sin(angle), 0.0)
-            low = to_local(journal_position, journal_rotation, to_world(
-                bore_position, bore_rotation, (radial[0], radial[1], -bore_half_length)))
-            high = to_local(journal_position, journal_rotation, to_world(
-                bore_position, bore_rotation, (radial[0], radial[1], bore_half_length)))
-            distance, point, gradient = _segment_in_cylinder(low, high, journal_radius,
-                                                             journal_half_length)
-            if distance < best:
-                best, best_local, best_gradient = distance, point, gradient
-                best_z = dot(sub(to_world(journal_position, journal_rotation, point),
-                                 bore_position), axis_b)
+            c, s = math.cos(angle), math.sin(angle)
+            for segment in range(4 if rims == 2 else 1):
+                if segment < 2:
+                    r = bore_radius + segment * bore_depth
+                    first = (r * c, r * s, -bore_half_length)
+                    second = (r * c, r * s, bore_half_length)
+                else:
+                    z = (2 * segment - 5) * bore_half_length  # -h, then +h
+                    back = bore_radius + bore_depth
+                    first = (bore_radius * c, bore_radius * s, z)
+                    second = (back * c, back * s, z)
+                low = to_local(journal_position, journal_rotation,
+                               to_world(bore_position, bore_rotation, first))
+                high = to_local(journal_position, journal_rotation,
+                                to_world(bore_position, bore_rotation, second))
+                distance, point, gradient = _segment_in_cylinder(low, high, journal_radius,
+                                                                 journal_half_length)
+                if distance < best:
+                    best, best_local, best_gradient = distance, point, gradient
+                    best_z = dot(sub(to_world(journal_position, journal_rotation, point),
+                                     bore_position), axis_b)
     surface = axpy(-best, best_gradient, best_local)
     return (best, to_world(journal_position, journal_rotation, surface),
             rotate(journal_rotation, best_gradient), best_z)

@@ -192,12 +192,13 @@ def _stage_support(k, phase, step, count, is_arc, centre, e1, e2, radius, kind, 
     bound is then held up at the crossings, whatever its own frame, not only by the supports
     on one side of its centre. There the contact is the ring against the edge line
     (:func:`~.ring_edges.ring_edge_contact`) where that holds, else the ring point's distance to
-    the solid."""
+    the solid. Returns True if the support was moved (an arc's end then no longer holds its
+    end point: :func:`ring_face` stages a minimum there)."""
     theta = phase + k * step
     if not _point_beyond(theta, centre, e1, e2, radius, kind, size_1, size_2):
         _stage_ring_point(k, theta, centre, e1, e2, radius, kind, size_1, size_2, depth,
                           face_position, face_rotation, stage)
-        return
+        return False
     previous_within = (k > 0 or not is_arc) and not _point_beyond(
         theta - step, centre, e1, e2, radius, kind, size_1, size_2)
     next_within = (k < count - 1 or not is_arc) and not _point_beyond(
@@ -217,7 +218,7 @@ def _stage_support(k, phase, step, count, is_arc, centre, e1, e2, radius, kind, 
     else:
         _stage_ring_point(k, theta, centre, e1, e2, radius, kind, size_1, size_2, depth,
                           face_position, face_rotation, stage)
-        return
+        return False
     is_edge, gap, on_edge, normal = ring_edge_contact(
         theta, centre, e1, e2, radius, kind, size_1, size_2, depth,
         max(theta - spacing, low_limit), min(theta + spacing, high_limit))
@@ -227,6 +228,7 @@ def _stage_support(k, phase, step, count, is_arc, centre, e1, e2, radius, kind, 
     else:
         _stage_ring_point(k, theta, centre, e1, e2, radius, kind, size_1, size_2, depth,
                           face_position, face_rotation, stage)
+    return True
 
 
 @njit(cache=True, inline="always")
@@ -276,11 +278,17 @@ def ring_face(kind, size_1, size_2, depth, face_position, face_rotation, ring_po
     # The ring's axis against the face's normal (z): within _LYING of it, the ring lies on the
     # face and its support points beyond the bound move to where it crosses the bound.
     lying = abs(e1[0] * e2[1] - e1[1] * e2[0]) >= _LYING
+    start_moved = False
+    end_moved = False
     for k in range(SUPPORT_POINTS):
         if lying:
-            _stage_support(k, phase, per_gap * spacing, SUPPORT_POINTS, is_arc, centre, e1,
-                           e2, radius, kind, size_1, size_2, depth, low_limit, high_limit,
-                           spacing, face_position, face_rotation, stage)
+            moved = _stage_support(k, phase, per_gap * spacing, SUPPORT_POINTS, is_arc, centre,
+                                   e1, e2, radius, kind, size_1, size_2, depth, low_limit,
+                                   high_limit, spacing, face_position, face_rotation, stage)
+            if k == 0:
+                start_moved = moved
+            elif k == SUPPORT_POINTS - 1:
+                end_moved = moved
         else:
             _stage_ring_point(k, phase + k * per_gap * spacing, centre, e1, e2, radius, kind,
                               size_1, size_2, depth, face_position, face_rotation, stage)
@@ -322,7 +330,8 @@ def ring_face(kind, size_1, size_2, depth, face_position, face_rotation, ring_po
             elif here > higher_value:
                 higher_value, higher_index = here, i
         before, here = here, following
-    # Refine the minima; one at an arc's end is that end's support point.
+    # Refine the minima; one at an arc's end is that end's support point, unless that support
+    # was moved to a crossing of the bound (the end itself then has no other candidate).
     found = 0
     found_angle = (0.0, 0.0)
     found_value = (0.0, 0.0)
@@ -338,7 +347,8 @@ def ring_face(kind, size_1, size_2, depth, face_position, face_rotation, ring_po
         value = _distance(theta, centre, e1, e2, radius, kind, size_1, size_2, depth)
         theta, value = _minimise(low, high, theta, value, centre, e1, e2, radius, kind, size_1,
                                  size_2, depth)
-        if is_arc and (theta - phase < _AT_END or phase + span - theta < _AT_END):
+        if is_arc and ((theta - phase < _AT_END and not start_moved)
+                       or (phase + span - theta < _AT_END and not end_moved)):
             continue
         if found == 0:
             found_angle = (theta, 0.0)
