@@ -22,8 +22,10 @@ The candidates (slots, :data:`RING_FACE_SLOTS` = 8, all always kept):
   one sample of each side. A minimum in the middle of the face is the ring's lowest point there;
   beyond the bound it is the ring's nearest point to the face's edge; for a ring lying across
   the edge the two minima are where it crosses it. A minimum at an arc's end is that end's
-  support point; a slot left without a minimum takes the ring's highest sample point that is not
-  a support point (a true ring point far from the face, inactive unless the ring lies flat).
+  support point, unless that support was moved to a crossing of the face's bound (then the
+  minimum holds the end); a slot left without a minimum takes the ring's highest sample point
+  that is not a support point (a true ring point far from the face, inactive unless the ring
+  lies flat).
 """
 
 from __future__ import annotations
