@@ -502,6 +502,66 @@ def _cylinder_solid_distance(points, radius, half_length):
     return np.where((radial <= 0.0) & (axial <= 0.0), np.maximum(radial, axial), outside)
 
 
+def _tilted_journal_in_a_full_bore(radius, half_length, tilt, end_centre):
+    """A journal (``radius``, ``half_length``) tilted by ``tilt`` [rad] about x, its +z end
+    face's centre at ``end_centre``, and a full bore without a back (r 0.5, half length 1) at
+    the origin: (journal, journal pose, bore, bore pose, the bore's +z end rim sampled every
+    1e-5 rad in the journal's frame (n, 3))."""
+    journal = Cylinder("a", radius=radius, half_length=half_length)
+    bore = Bore("b", radius=0.5, half_length=1.0)
+    turn = _about((1.0, 0.0, 0.0), tilt)
+    axes = np.column_stack([_rotate(turn, axis) for axis in np.eye(3)])
+    centre = np.asarray(end_centre, dtype=float) - half_length * axes[:, 2]
+    angles = np.arange(0.0, 2.0 * math.pi, 1e-5)
+    rim = np.c_[0.5 * np.cos(angles), 0.5 * np.sin(angles), np.ones(angles.size)]
+    return (journal, (centre, turn), bore, (np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0])),
+            (rim - centre) @ axes)
+
+
+@pytest.mark.parametrize("swapped", [False, True], ids=["journal-bore", "bore-journal"])
+def test_a_journal_just_past_a_full_bores_end_is_read_as_finite(swapped):
+    """A journal (r 0.45, half length 0.2) tilted 0.1 rad about x, in a full bore without a
+    back (r 0.5, half length 1; the C-60's plunger bearing is one), its axis's end 0.002 past
+    the bore's +z end, 0.03 toward -y: past its end the journal's axis heads on toward the
+    bore's wall. The bore's rim is measured against the journal's finite solid: the journal
+    taken as infinitely long (the kernel before it, for a full bore without a back) reads
+    the rim 0.0179 from it where the journal is 0.0222 from the bore's solid (the instrument),
+    a contact seen 0.0044 early (in c60-trip: 0.001 mm read where the plunger was 0.0018 mm
+    away). The infinitely long reading is computed here from the rim's samples (error below
+    1e-10)."""
+    journal, journal_pose, bore, bore_pose, rim = _tilted_journal_in_a_full_bore(
+        0.45, 0.2, 0.1, (0.0, -0.03, 1.002))
+    infinitely_long = float(np.min(np.hypot(rim[:, 0], rim[:, 1]) - 0.45))
+    reading = independent_gap(journal, journal_pose, bore, bore_pose)
+    assert infinitely_long < reading.gap - reading.resolution - 4e-3  # the docstring's place
+    pairs = (bore, bore_pose, journal, journal_pose) if swapped else \
+        (journal, journal_pose, bore, bore_pose)
+    kernel = contacts_between(*pairs)
+    assert reading.gap - reading.resolution - TOLERANCE <= float(np.min(kernel.gap)) \
+        <= reading.gap + TOLERANCE
+    _check(("cylinder", "bore"), swapped, (journal, journal_pose, bore, bore_pose))
+
+
+def test_a_tilted_journals_end_face_past_a_full_bores_rim_is_seen():
+    """A journal (r 0.45, half length 0.5) tilted 0.05 rad about x in a full bore without a
+    back (r 0.5, half length 1), its axis ending 0.01 inside the bore's +z end: its end face
+    is tilted, so its edge on the +y side reaches 0.0125 past the bore's end. The +z side's
+    candidate is the bore's end rim against that edge, 0.049875 away (the rim's samples
+    against the journal's solid, computed here); the kernel before it read the journal's own
+    end rim against the bore's surface there, 0.05, the radial gap as if the bore went on.
+    (The pair's smallest gap is at the journal's -z end, 0.0006, which the property test
+    compares; this test reads the +z side's slot.)"""
+    journal, journal_pose, bore, bore_pose, rim = _tilted_journal_in_a_full_bore(
+        0.45, 0.5, 0.05, (0.0, 0.0, 0.99))
+    edge = float(np.min(_cylinder_solid_distance(rim, 0.45, 0.5)))
+    assert abs(edge - 0.049875) < 1e-6  # the place the docstring describes
+    kernel = contacts_between(journal, journal_pose, bore, bore_pose)
+    plus_z = [k for k in range(kernel.count) if kernel.point_b[k, 2] > 0.5]  # the upper end
+    assert len(plus_z) == 1
+    assert abs(kernel.gap[plus_z[0]] - edge) < TOLERANCE
+    _check(("cylinder", "bore"), False, (journal, journal_pose, bore, bore_pose))
+
+
 @pytest.mark.parametrize("swapped", [False, True], ids=["journal-bore", "bore-journal"])
 def test_a_journal_beyond_a_half_bearing_is_nearest_its_backs_rim(swapped):
     """A journal (r 0.5, half length 0.25) at the origin, a partial bore (r 0.5, 0 to 5 rad,

@@ -12,7 +12,6 @@ from clearbench.kernels.gaps.rings import (
     arc_angle_in_range,
     ring_angle,
     ring_axis_distance,
-    ring_cylinder,
 )
 from clearbench.kernels.gaps.round_solids import (
     _GOLDEN,
@@ -34,6 +33,7 @@ from clearbench.kernels.gaps.vectors import (
     axpy,
     column_of,
     dot,
+    norm,
     rotate,
     rotate_back,
     scaled,
@@ -133,20 +133,12 @@ def _cylinder_end_in_bore(end, direction, centre, reach, journal_position, journ
     if end * (centre + end * reach) > bore_half_length:
         # The journal runs beyond this end of the bore: the bore's end rim.
         rim_position = axpy(end * bore_half_length, axis_b, bore_position)
-        is_arc = bore_span < TWO_PI
-        if is_arc or bore_depth > 0.0:
-            ring_cylinder_solid(rim_position, bore_rotation, bore_radius, bore_start,
-                                bore_span, is_arc, journal_position, journal_rotation,
-                                journal_radius, journal_half_length, stage[index:])
-        else:
-            # A full bore without a back (the C-60's plunger bearing): the journal taken as
-            # infinitely long here, as before the finite journal was read for the others; its
-            # end passing the bearing's end in c60-trip reads 0.001 mm where the finite
-            # journal reads 0.0018 mm (docs/contact-geometry.md): a change of the C-60's
-            # physics left for a validated change.
-            ring_cylinder(rim_position, bore_rotation, bore_radius, bore_start, bore_span,
-                          is_arc, journal_position, journal_rotation, journal_radius,
-                          stage[index:])
+        # Against the journal's finite solid: where the journal's end has just passed the
+        # rim, the rim's nearest point can lie beyond that end (the infinitely long journal
+        # read 0.001 mm there in c60-trip's plunger bearing, the finite one 0.0018 mm).
+        ring_cylinder_solid(rim_position, bore_rotation, bore_radius, bore_start, bore_span,
+                            bore_span < TWO_PI, journal_position, journal_rotation,
+                            journal_radius, journal_half_length, stage[index:])
         # Mirror into (A = journal, B = bore): normal from the journal outward.
         gap = stage[index, 2, 0]
         normal = (-stage[index, 0, 0], -stage[index, 0, 1], -stage[index, 0, 2])
@@ -390,9 +382,8 @@ def _cylinder_in_bore(journal_position, journal_rotation, journal_radius, journa
             bore_depth)
         stage_contact(stage, 1, edge, point, normal)
         kept_0 = within_depth(bore_depth, stage, 0)
-        apart = math.sqrt((stage[1, 1, 0] - stage[0, 1, 0]) ** 2
-                          + (stage[1, 1, 1] - stage[0, 1, 1]) ** 2
-                          + (stage[1, 1, 2] - stage[0, 1, 2]) ** 2)
+        apart = norm(sub((stage[1, 1, 0], stage[1, 1, 1], stage[1, 1, 2]),
+                         (stage[0, 1, 0], stage[0, 1, 1], stage[0, 1, 2])))
         return 2, kept_0, not kept_0 or apart > SAME_CONTACT * journal_radius
     local = to_local(bore_position, bore_rotation, journal_position)
     in_hole = math.hypot(local[0], local[1]) < bore_radius
@@ -419,11 +410,15 @@ def _cylinder_in_bore(journal_position, journal_rotation, journal_radius, journa
                 kept_0 = True
             else:
                 kept_1 = True
-    if bore_span < TWO_PI or bore_depth > 0.0:
+    tilt_reach = journal_radius * math.sqrt(max(0.0, 1.0 - dot(axis_j, axis_b) ** 2))
+    end_face_out = abs(centre) + reach + tilt_reach > bore_half_length
+    if bore_span < TWO_PI or bore_depth > 0.0 or end_face_out:
         # A partial bore or one with a back: its edges inside the journal, deeper than the
         # journal's rims where the journal lies across its cut or its end, replace the
         # candidate of their side. A full bore without a back (the C-60's plunger bearing)
-        # has no such place: its end rims are seen at the overlap's ends.
+        # has such a place only where the journal's end face reaches past the bore's end (a
+        # tilted journal whose axis ends inside: the bore's end rim meets the end face's
+        # edge, which the journal's own rim, read against the bore's surface, does not see).
         edge, point, normal, z = _bore_edges_in_journal(
             journal_position, journal_rotation, journal_radius, journal_half_length,
             bore_position, bore_rotation, bore_radius, bore_half_length, bore_start, bore_span,
