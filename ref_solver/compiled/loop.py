@@ -25,6 +25,7 @@ from clearbench.ref_solver.compiled.system_arrays import (
     history_length,
 )
 from clearbench.ref_solver.forces import remember_angles, rotation_matrices
+from clearbench.ref_solver.projection_kernel import candidates
 
 #: Status codes of :func:`advance`.
 OK, UNCONVERGED, NON_FINITE = 0, 1, 2
@@ -132,9 +133,11 @@ def _advance(s, cfg, memory, t, x, p, v, omega, steps, schedule, history, rec):
     sample = np.int64(1)  # np.int64: a literal 1 would compile the _store_* kernels twice
     iterations, residual, converged = 0, 0.0, True
     status = OK
+    # The candidates at the step's start: the previous step's closing test computed them.
+    cand = candidates(s.geometry, x, rotation_matrices(p))
     for k in range(1, steps + 1):
         (x1, p1, v1, omega1, impulses, frames, active, its, res, ok, projection_ok,
-         sweeps) = single_step(s, cfg, memory, t, x, p, v, omega, history)
+         sweeps, cand) = single_step(s, cfg, memory, t, x, p, v, omega, history, cand)
         remember_angles(rotation_matrices(p1), s.force_kind, s.force_body_a, s.force_body_b,
                         s.force_parameters, memory[3])
         t = t + cfg.time_step

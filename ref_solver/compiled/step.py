@@ -189,15 +189,19 @@ def _projection_stage(s, cfg, t, x, p, active, closed):
 
 
 @njit(cache=True)
-def single_step(s, cfg, memory, t, x, p, v, omega, history):
+def single_step(s, cfg, memory, t, x, p, v, omega, history, cand):
     """One step of length ``cfg.time_step`` from (t, x (nb, 3), p (nb, 4), v (nb, 3), omega
-    (nb, 3)) (not modified).
+    (nb, 3)) (not modified), whose contact candidates are ``cand``
+    (:func:`~clearbench.ref_solver.projection_kernel.candidates` at (x, p)).
 
     ``memory`` = (previous impulses (npair, K, 3), previous bilateral impulses (nbil,), the
     hybrid chain's ``newton_first`` (1,)), the warm starts, updated in place. Returns (x, p, v,
     omega at t + h, impulses (npair, K, 3) in the contact frames [F T], frames (npair, K, 3, 3)
     of the contacts at the start of the step, active (npair, K), solver iterations, residual,
-    converged, projection converged, contact sweeps).
+    converged, projection converged, contact sweeps, the candidates at the returned (x, p)).
+    The last activation round's closing test computes those candidates; the next step starts
+    from them instead of computing them again (the same kernel on the same state: the same
+    values to the bit).
     """
     h = cfg.time_step
     theta = cfg.theta
@@ -211,10 +215,10 @@ def single_step(s, cfg, memory, t, x, p, v, omega, history):
         s.inverse_inertia, s.gravity, s.fixed, s.force_kind, s.force_body_a, s.force_body_b,
         s.force_parameters, memory[3], s.has_springs, cfg.length_step, s.mass_matrix,
         s.inverse_mass, s.cluster_dofs, s.cluster_start)
-    cand = candidates(s.geometry, x, rotation)
     active = first_round_active(s, cfg, x, rotation, cand, nu, free, memory[0])
     iterations, sweeps, rounds = 0, 0, 0
     projection_converged = True
+    cand_new = cand
     while True:
         rounds += 1
         (x_new, p_new, v_new, omega_new, impulses, closed, its, residual, converged,
@@ -223,6 +227,7 @@ def single_step(s, cfg, memory, t, x, p, v, omega, history):
         iterations += its
         sweeps += more_sweeps
         if not cfg.projection:
+            cand_new = candidates(s.geometry, x_new, rotation_matrices(p_new))
             break
         _, _, projection_converged = _projection_stage(s, cfg, t + h, x_new, p_new, active,
                                                        closed)
@@ -238,4 +243,4 @@ def single_step(s, cfg, memory, t, x, p, v, omega, history):
             if active[i, k]:
                 previous_impulse[i, k] = impulses[i, k]
     return (x_new, p_new, v_new, omega_new, impulses, cand[3], active, iterations, residual,
-            converged, projection_converged, sweeps)
+            converged, projection_converged, sweeps, cand_new)
