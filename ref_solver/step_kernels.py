@@ -1,4 +1,5 @@
-"""Compiled pieces of one Moreau–Jean step: the free velocity and the velocity-stage rows.
+"""Compiled pieces of one Moreau–Jean step: the free velocity, the velocity-stage rows and the
+crossing fraction of an impact localised within a step.
 
 Both do what ``MoreauJeanStepper._single_step`` (step 1) and ``_velocity_stage`` (the
 assembly of the one-step problem) did in numpy, in one numba call each, so that a step of a
@@ -6,6 +7,8 @@ small mechanism does not pay tens of numpy calls from Python.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 from numba import njit
@@ -128,3 +131,44 @@ def velocity_problem(arrays, n_bilateral, n_joint_rows, t1, h, theta, x, p, v, o
         if impacting[c]:
             q[n_bilateral + 3 * c] += restitution[pairs[c]] * u_k[c]
     return w, y, q, row_body, row_coef, u_k, impacting
+
+
+@njit(cache=True)
+def crossing_fraction(gap_start, gap_rate, gap_end):
+    """Fraction s in (0, 1] of a step at which a contact's gap reaches zero.
+
+    The gap over the step is taken as the quadratic g(s) = g0 + b s + c s^2 through the gap at
+    the start g0 = ``gap_start`` > 0 [L], its rate b = ``gap_rate`` = h u_N,k [L] (normal
+    velocity times the step) and the gap at the end of the step's free motion g1 =
+    ``gap_end`` <= 0 [L] (the caller checks both signs): exact for ballistic flight (constant
+    acceleration), where the theta = 1/2 position update is exact. Returns the smallest root in
+    (0, 1] (there is exactly one, since g(0) > 0 >= g(1)); where round-off put it just outside,
+    the quadratic is bisected.
+    """
+    g0, b, g1 = gap_start, gap_rate, gap_end
+    c = g1 - g0 - b
+    best = math.inf
+    if c == 0.0:
+        if b != 0.0:
+            root = -g0 / b
+            if 0.0 < root <= 1.0:
+                best = root
+    else:
+        q = -0.5 * (b + math.copysign(math.sqrt(max(b * b - 4.0 * c * g0, 0.0)), b))
+        root = q / c
+        if 0.0 < root <= 1.0:
+            best = root
+        if q != 0.0:
+            root = g0 / q
+            if 0.0 < root <= 1.0:
+                best = min(best, root)
+    if best < math.inf:
+        return best
+    low, high = 0.0, 1.0
+    for _ in range(80):
+        middle = 0.5 * (low + high)
+        if g0 + middle * (b + c * middle) > 0.0:
+            low = middle
+        else:
+            high = middle
+    return high

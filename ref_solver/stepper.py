@@ -93,6 +93,7 @@ from clearbench.ref_solver.projection_kernel import (
     geometry_arrays,
     project,
 )
+from clearbench.ref_solver.step_kernels import crossing_fraction as crossing_fraction_kernel
 from clearbench.ref_solver.step_kernels import free_velocity, velocity_problem
 from clearbench.ref_solver.system import MultibodySystem, State
 from clearbench.scenarios.geometry import MAX_CONTACTS_PER_PAIR
@@ -896,40 +897,12 @@ class MoreauJeanStepper:
 
 
 def crossing_fraction(gap_start: float, gap_rate: float, gap_end: float) -> float:
-    """Fraction s in (0, 1] of a step at which a contact's gap reaches zero.
-
-    The gap over the step is taken as the quadratic g(s) = g0 + b s + c s^2 through the gap at
-    the start g0 > 0 [L], its rate b = h u_N,k [L] (normal velocity times the step) and the
-    gap at the end of the step's free motion g1 <= 0 [L]: exact for ballistic flight (constant
-    acceleration), where the theta = 1/2 position update is exact. Returns the root in (0, 1]
-    (there is exactly one, since g(0) > 0 >= g(1)).
-    """
-    g0, b, g1 = gap_start, gap_rate, gap_end
-    if not (g0 > 0.0 and g1 <= 0.0):
-        raise ValueError(f"need gap_start > 0 >= gap_end, got {g0!r}, {g1!r}")
-    c = g1 - g0 - b
-    roots = []
-    if c == 0.0:
-        if b != 0.0:
-            roots.append(-g0 / b)
-    else:
-        root = np.sqrt(max(b * b - 4.0 * c * g0, 0.0))
-        q = -0.5 * (b + np.copysign(root, b))
-        roots.append(q / c)
-        if q != 0.0:
-            roots.append(g0 / q)
-    inside = [r for r in roots if 0.0 < r <= 1.0]
-    if inside:
-        return float(min(inside))
-    # Round-off put the root just outside (0, 1]: bisect the quadratic.
-    low, high = 0.0, 1.0
-    for _ in range(80):
-        middle = 0.5 * (low + high)
-        if g0 + middle * (b + c * middle) > 0.0:
-            low = middle
-        else:
-            high = middle
-    return high
+    """Fraction s in (0, 1] of a step at which a contact's gap reaches zero
+    (:func:`~clearbench.ref_solver.step_kernels.crossing_fraction`, which both step loops
+    call); a ValueError unless gap_start > 0 >= gap_end [L]."""
+    if not (gap_start > 0.0 and gap_end <= 0.0):
+        raise ValueError(f"need gap_start > 0 >= gap_end, got {gap_start!r}, {gap_end!r}")
+    return float(crossing_fraction_kernel(float(gap_start), float(gap_rate), float(gap_end)))
 
 
 @dataclass(frozen=True)

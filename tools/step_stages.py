@@ -73,7 +73,7 @@ def timed_steps(s, cfg, memory, t, x, p, v, omega, history, n, seconds, counts, 
         t1 = _now()
         seconds[0] += t1 - t0
         cand = candidates(s.geometry, x, rotation)
-        active = first_round_active(s, cfg, x, rotation, cand, nu, free, memory[0])
+        active = first_round_active(s, cfg, h, x, rotation, cand, nu, free, memory[0])
         seconds[1] += _now() - t1
         rounds = 0
         while True:

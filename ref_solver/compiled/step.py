@@ -15,7 +15,11 @@ from clearbench.ref_solver.constraints import contact_rows, row_values
 from clearbench.ref_solver.forces import rotation_matrices
 from clearbench.ref_solver.gyroscopic import integrate_orientations
 from clearbench.ref_solver.projection_kernel import candidates, closed_gap_limit, project
-from clearbench.ref_solver.step_kernels import free_velocity, velocity_problem
+from clearbench.ref_solver.step_kernels import (
+    crossing_fraction,
+    free_velocity,
+    velocity_problem,
+)
 
 
 @njit(cache=True)
@@ -73,9 +77,9 @@ def _normal_velocities(s, x, rotation, cand, nu, free):
 
 
 @njit(cache=True)
-def first_round_active(s, cfg, x, rotation, cand, nu, free, previous):
-    """(npair, K) bool: the contacts of the step's first activation round under
-    ``cfg.activation_rule`` (:func:`clearbench.ref_solver.activation.first_round`);
+def first_round_active(s, cfg, h, x, rotation, cand, nu, free, previous):
+    """(npair, K) bool: the contacts of the first activation round of a step of length ``h``
+    [T] under ``cfg.activation_rule`` (:func:`clearbench.ref_solver.activation.first_round`);
     ``previous`` (npair, K, 3) the previous step's impulses."""
     if cfg.activation_rule == RULE_GAP:
         return valid_slots(cand[4], cand[0] <= cfg.activation_margin)
@@ -84,7 +88,7 @@ def first_round_active(s, cfg, x, rotation, cand, nu, free, previous):
     else:
         u_start, u_free = _normal_velocities(s, x, rotation, cand, nu, free)
     active = first_round(
-        cfg.activation_rule, cand[0], u_start, u_free, previous, cfg.time_step, cfg.theta,
+        cfg.activation_rule, cand[0], u_start, u_free, previous, h, cfg.theta,
         cfg.activation_margin, cfg.activation_hold, s.pair_restitution,
         cfg.restitution_threshold)
     return valid_slots(cand[4], active)
@@ -189,21 +193,48 @@ def _projection_stage(s, cfg, t, x, p, active, closed):
 
 
 @njit(cache=True)
-def single_step(s, cfg, memory, t, x, p, v, omega, history, cand):
-    """One step of length ``cfg.time_step`` from (t, x (nb, 3), p (nb, 4), v (nb, 3), omega
-    (nb, 3)) (not modified), whose contact candidates are ``cand``
-    (:func:`~clearbench.ref_solver.projection_kernel.candidates` at (x, p)).
+def _crossing(s, cfg, h, x, rotation, cand, cand_end, closing, nu, free):
+    """The contacts that call for impact localisation among ``closing`` (npair, K) (open at
+    the step's start, closed at the end of its first activation round): of a pair with
+    restitution > 0, open at the start (finite gap > 0) and approaching faster than the
+    restitution threshold. Returns (the crossing fraction of the earliest of them in (0, 1],
+    +inf when there is none; their mask (npair, K)), as ``MoreauJeanStepper._crossing``."""
+    mask = np.zeros_like(closing)
+    earliest = np.inf
+    u_start = np.zeros_like(cand[0])
+    computed = False
+    for i in range(closing.shape[0]):
+        if not s.pair_restitution[i] > 0.0:
+            continue
+        for k in range(closing.shape[1]):
+            start = cand[0][i, k]
+            if not (closing[i, k] and np.isfinite(start) and start > 0.0):
+                continue
+            if not computed:
+                u_start = _normal_velocities(s, x, rotation, cand, nu, free)[0]
+                computed = True
+            if u_start[i, k] < -cfg.restitution_threshold:
+                mask[i, k] = True
+                earliest = min(earliest, crossing_fraction(start, u_start[i, k] * h,
+                                                           cand_end[0][i, k]))
+    return earliest, mask
 
-    ``memory`` = (previous impulses (npair, K, 3), previous bilateral impulses (nbil,), the
-    hybrid chain's ``newton_first`` (1,)), the warm starts, updated in place. Returns (x, p, v,
-    omega at t + h, impulses (npair, K, 3) in the contact frames [F T], frames (npair, K, 3, 3)
-    of the contacts at the start of the step, active (npair, K), solver iterations, residual,
-    converged, projection converged, contact sweeps, the candidates at the returned (x, p)).
-    The last activation round's closing test computes those candidates; the next step starts
-    from them instead of computing them again (the same kernel on the same state: the same
-    values to the bit).
+
+@njit(cache=True)
+def _substep(s, cfg, memory, t, h, x, p, v, omega, history, cand, suppress, watch):
+    """Steps 1-5 of the scheme over a step of length h >= 0 [T] from (t, x (nb, 3), p (nb, 4),
+    v (nb, 3), omega (nb, 3)) (not modified), whose contact candidates are ``cand``
+    (:func:`~clearbench.ref_solver.projection_kernel.candidates` at (x, p)), as
+    ``MoreauJeanStepper._single_step``: ``suppress`` (npair, K) the contacts the activation loop
+    must not add; ``watch``: when the first activation round closes contacts that call for
+    impact localisation (:func:`_crossing`), stop there.
+
+    Returns (x, p, v, omega at t + h, impulses (npair, K, 3) in the contact frames [F T], active
+    (npair, K), solver iterations, residual, converged, projection converged, contact sweeps,
+    the candidates at the returned (x, p), the crossing fraction (+inf: the step is complete;
+    else the step was stopped and only its iterations and sweeps count), the crossing mask).
+    The previous impulses of ``memory`` are those of the completed step.
     """
-    h = cfg.time_step
     theta = cfg.theta
     rotation = rotation_matrices(p)
     nb = x.shape[0]
@@ -215,10 +246,11 @@ def single_step(s, cfg, memory, t, x, p, v, omega, history, cand):
         s.inverse_inertia, s.gravity, s.fixed, s.force_kind, s.force_body_a, s.force_body_b,
         s.force_parameters, memory[3], s.has_springs, cfg.length_step, s.mass_matrix,
         s.inverse_mass, s.cluster_dofs, s.cluster_start)
-    active = first_round_active(s, cfg, x, rotation, cand, nu, free, memory[0])
+    active = first_round_active(s, cfg, h, x, rotation, cand, nu, free, memory[0])
     iterations, sweeps, rounds = 0, 0, 0
     projection_converged = True
     cand_new = cand
+    no_crossing = np.zeros_like(active)
     while True:
         rounds += 1
         (x_new, p_new, v_new, omega_new, impulses, closed, its, residual, converged,
@@ -232,7 +264,13 @@ def single_step(s, cfg, memory, t, x, p, v, omega, history, cand):
         _, _, projection_converged = _projection_stage(s, cfg, t + h, x_new, p_new, active,
                                                        closed)
         cand_new = candidates(s.geometry, x_new, rotation_matrices(p_new))
-        closing = valid_slots(cand_new[4], cand_new[0] <= 0.0) & ~active
+        closing = valid_slots(cand_new[4], cand_new[0] <= 0.0) & ~active & ~suppress
+        if watch and rounds == 1 and closing.any():
+            fraction, mask = _crossing(s, cfg, h, x, rotation, cand, cand_new, closing, nu,
+                                       free)
+            if fraction < np.inf:
+                return (x_new, p_new, v_new, omega_new, impulses, active, iterations, 0.0,
+                        True, True, sweeps, cand_new, fraction, mask)
         if not closing.any() or rounds >= cfg.max_activation_rounds:
             break
         active = active | closing
@@ -242,5 +280,108 @@ def single_step(s, cfg, memory, t, x, p, v, omega, history, cand):
         for k in range(active.shape[1]):
             if active[i, k]:
                 previous_impulse[i, k] = impulses[i, k]
-    return (x_new, p_new, v_new, omega_new, impulses, cand[3], active, iterations, residual,
-            converged, projection_converged, sweeps, cand_new)
+    return (x_new, p_new, v_new, omega_new, impulses, active, iterations, residual,
+            converged, projection_converged, sweeps, cand_new, np.inf, no_crossing)
+
+
+@njit(cache=True)
+def _add_piece(world, frames, active, impulses, piece_frames, piece_active):
+    """Adds a substep's impulses (npair, K, 3, contact frames ``piece_frames`` (npair, K, 3,
+    3)) of its active contacts to ``world`` (npair, K, 3) (world axes); ``frames`` takes the
+    piece's frames and ``active`` its contacts, as ``MoreauJeanStepper._combine``."""
+    for i in range(world.shape[0]):
+        for k in range(world.shape[1]):
+            if piece_active[i, k]:
+                for j in range(3):
+                    world[i, k, j] += (impulses[i, k, 0] * piece_frames[i, k, 0, j]
+                                       + impulses[i, k, 1] * piece_frames[i, k, 1, j]
+                                       + impulses[i, k, 2] * piece_frames[i, k, 2, j])
+                    for a in range(3):
+                        frames[i, k, a, j] = piece_frames[i, k, a, j]
+                active[i, k] = True
+
+
+@njit(cache=True)
+def single_step(s, cfg, memory, t, x, p, v, omega, history, cand):
+    """One step of length ``cfg.time_step`` from (t, x (nb, 3), p (nb, 4), v (nb, 3), omega
+    (nb, 3)) (not modified), whose contact candidates are ``cand``
+    (:func:`~clearbench.ref_solver.projection_kernel.candidates` at (x, p)), with impact
+    localisation when ``cfg.impact_splits`` > 0 (``MoreauJeanStepper._advance``: a step whose
+    first activation round closes an impacting contact is redone as the free motion to the
+    crossing, the impact as a step of zero length and the rest of the step, at most
+    ``impact_splits`` times; the impulses of the pieces summed in world axes and given in the
+    frames of each contact's last piece).
+
+    ``memory`` = (previous impulses (npair, K, 3), previous bilateral impulses (nbil,), the
+    hybrid chain's ``newton_first`` (1,)), the warm starts, updated in place. Returns (x, p, v,
+    omega at t + h, impulses (npair, K, 3) in the contact frames [F T], frames (npair, K, 3, 3)
+    of the contacts at the start of the step (of their last piece), active (npair, K), solver
+    iterations, residual, converged, projection converged, contact sweeps, the candidates at
+    the returned (x, p)). The last activation round's closing test computes those candidates;
+    the next step starts from them instead of computing them again (the same kernel on the
+    same state: the same values to the bit).
+    """
+    none = np.zeros(cand[0].shape, dtype=np.bool_)
+    h = cfg.time_step
+    splits = cfg.impact_splits
+    result = _substep(s, cfg, memory, t, h, x, p, v, omega, history, cand, none, splits > 0)
+    if result[12] == np.inf:
+        return (result[0], result[1], result[2], result[3], result[4], cand[3], result[5],
+                result[6], result[7], result[8], result[9], result[10], result[11])
+    world = np.zeros_like(result[4])
+    frames = cand[3].copy()
+    active = np.zeros_like(none)
+    # The abandoned first round's work counts in the cost, not in the convergence.
+    iterations, residual, converged = result[6], 0.0, True
+    projection_converged, sweeps = True, result[10]
+    while True:
+        # (a) The free motion to the crossing, the crossing contacts not activated.
+        fraction = min(result[12] * (1.0 + 1e-9) + 4.0 * np.finfo(np.float64).eps, 1.0)
+        h1 = fraction * h
+        mask = result[13]
+        piece = _substep(s, cfg, memory, t, h1, x, p, v, omega, history, cand, mask, False)
+        _add_piece(world, frames, active, piece[4], cand[3], piece[5])
+        t = t + h1
+        x, p, v, omega, cand = piece[0], piece[1], piece[2], piece[3], piece[11]
+        iterations += piece[6]
+        residual = max(residual, piece[7])
+        converged = converged and piece[8]
+        projection_converged = projection_converged and piece[9]
+        sweeps += piece[10]
+        # (b) The impact at the crossing as a step of zero length, unless every crossing
+        # contact is still open there (the rest of the step then takes it).
+        if (valid_slots(cand[4], cand[0] <= cfg.activation_margin) & mask).any():
+            piece = _substep(s, cfg, memory, t, 0.0, x, p, v, omega, history, cand, none,
+                             False)
+            _add_piece(world, frames, active, piece[4], cand[3], piece[5])
+            x, p, v, omega, cand = piece[0], piece[1], piece[2], piece[3], piece[11]
+            iterations += piece[6]
+            residual = max(residual, piece[7])
+            converged = converged and piece[8]
+            projection_converged = projection_converged and piece[9]
+            sweeps += piece[10]
+        if fraction >= 1.0:
+            break
+        # (c) The rest of the step, which may localise a later impact.
+        h = h - h1
+        splits -= 1
+        result = _substep(s, cfg, memory, t, h, x, p, v, omega, history, cand, none,
+                          splits > 0)
+        iterations += result[6]
+        sweeps += result[10]
+        if result[12] == np.inf:
+            _add_piece(world, frames, active, result[4], cand[3], result[5])
+            residual = max(residual, result[7])
+            converged = converged and result[8]
+            projection_converged = projection_converged and result[9]
+            x, p, v, omega, cand = result[0], result[1], result[2], result[3], result[11]
+            break
+    impulses = np.zeros_like(world)
+    for i in range(world.shape[0]):
+        for k in range(world.shape[1]):
+            for a in range(3):
+                impulses[i, k, a] = (frames[i, k, a, 0] * world[i, k, 0]
+                                     + frames[i, k, a, 1] * world[i, k, 1]
+                                     + frames[i, k, a, 2] * world[i, k, 2])
+    return (x, p, v, omega, impulses, frames, active, iterations, residual, converged,
+            projection_converged, sweeps, cand)

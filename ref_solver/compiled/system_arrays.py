@@ -82,6 +82,7 @@ class LoopSettings(NamedTuple):
     proximal_rescue: float          # StepperSettings.proximal_rescue (0: off)
     closed_gap_slack: float         # projection_kernel.closed_gap_slack [L]
     length_scale: float             # StepperSettings.length_scale [L]
+    impact_splits: int              # impacts localised per step (0: no impact localisation)
 
 
 def compile_system(stepper) -> tuple[CompiledSystem, LoopSettings]:
@@ -121,7 +122,8 @@ def compile_system(stepper) -> tuple[CompiledSystem, LoopSettings]:
         roundoff_floor=bool(solver.roundoff_floor),
         proximal_rescue=float(cfg.proximal_rescue),
         closed_gap_slack=float(closed_gap_slack(cfg.position_tolerance, cfg.length_scale)),
-        length_scale=float(cfg.length_scale))
+        length_scale=float(cfg.length_scale),
+        impact_splits=int(cfg.max_impact_splits) if cfg.localise_impacts else 0)
     return system, settings
 
 
