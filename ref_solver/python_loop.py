@@ -29,11 +29,9 @@ __all__ = ["PythonLoopTotals", "advance_python"]
 @dataclass
 class PythonLoopTotals:
     """What the Python loop measures beyond :class:`StepRecord`, over the steps completed:
-    ``solver_seconds`` [s] wall time in the contact solver, ``split_steps`` steps computed in
-    substeps (localised impacts)."""
+    ``solver_seconds`` [s] wall time in the contact solver."""
 
     solver_seconds: float = 0.0
-    split_steps: int = 0
 
 
 def advance_python(stepper, state: State, steps: int, schedule: np.ndarray,
@@ -67,9 +65,9 @@ def advance_python(stepper, state: State, steps: int, schedule: np.ndarray,
         record.step_converged[k - 1] = stats.solver_converged
         record.step_projection_converged[k - 1] = stats.projection_converged
         record.step_sweeps[k - 1] = stats.contact_sweeps
+        record.step_split[k - 1] = stats.substeps > 1
         record.progress[1] = k
         totals.solver_seconds += stats.solver_seconds
-        totals.split_steps += stats.substeps > 1
         if not (stats.solver_converged and stats.projection_converged):
             status = UNCONVERGED
         iterations += stats.solver_iterations

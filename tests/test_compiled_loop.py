@@ -52,7 +52,7 @@ def _supported(scene) -> bool:
 
 def _compare(name: str, options: dict | None = None, horizon: float | None = None):
     """Runs ``name`` in both loops (``horizon`` [T], default ``STEPS`` steps) and asserts their
-    agreement (module docstring); returns the Python loop's run."""
+    agreement (module docstring); returns the (Python, compiled) runs."""
     scene = get_scene(name)
     h = scene.time_step
     runs = {loop: create("default").run(scene, RunSettings(
@@ -84,7 +84,7 @@ def _compare(name: str, options: dict | None = None, horizon: float | None = Non
     assert np.max(np.abs(compiled.contact_force - python.contact_force), initial=0.0) \
         <= AGREEMENT * force
     np.testing.assert_array_equal(compiled.active_contacts, python.active_contacts)
-    return runs["python"]
+    return runs["python"], runs["compiled"]
 
 
 def _first_unconverged(trajectory) -> int:
@@ -141,8 +141,10 @@ def test_both_loops_localise_impacts_alike(name, impacts):
     # followed by one with an active contact), each a localised impact.
     scene = get_scene(name)
     horizon = {"flores-slider-crank": 0.01}.get(name, scene.horizon)
-    python = _compare(name, horizon=horizon)
+    python, compiled = _compare(name, horizon=horizon)
     assert python.metadata["localise_impacts"]
+    # The same steps split at an impact (each split step counted once).
+    assert compiled.metadata["split_steps"] == python.metadata["split_steps"] >= impacts
     touching = python.active_contacts > 0
     assert int(np.sum(touching[1:] & ~touching[:-1])) >= impacts
 

@@ -12,8 +12,11 @@ from clearbench.scenarios.library import get_scene
 
 
 def test_an_exception_in_a_step_is_a_crashed_run_with_the_state_it_started_from(monkeypatch):
+    # The Python step, whose step method is replaced below (bouncing-ball-e0.5 is compiled by
+    # default since impact localisation is).
     scene = get_scene("bouncing-ball-e0.5")
-    clean = create().run(scene, RunSettings(horizon=5 * scene.time_step))
+    python = {"step_loop": "python"}
+    clean = create().run(scene, RunSettings(horizon=5 * scene.time_step, options=python))
     original = stepper.MoreauJeanStepper.step
     calls = {"n": 0}
 
@@ -24,7 +27,7 @@ def test_an_exception_in_a_step_is_a_crashed_run_with_the_state_it_started_from(
         return original(self, state)
 
     monkeypatch.setattr(stepper.MoreauJeanStepper, "step", failing_step)
-    trajectory = create().run(scene, RunSettings(horizon=10 * scene.time_step))
+    trajectory = create().run(scene, RunSettings(horizon=10 * scene.time_step, options=python))
     assert trajectory.status is RunStatus.CRASHED
     assert "ZeroDivisionError in step 4" in trajectory.message
     # Samples 0..3 and the start of step 4 (= the end of step 3, repeated): the failing step

@@ -153,7 +153,7 @@ class RunStatistics:
         steps_done = np.arange(1, taken + 1)
         converged = record.step_converged[:taken]
         self.solver_seconds = totals.solver_seconds
-        self.split_steps = totals.split_steps
+        self.split_steps = int(np.sum(record.step_split[:taken]))
         self.contact_sweeps = int(record.step_sweeps[:taken].sum())
         self.roundoff_steps = int(np.sum(converged & (record.step_residual[:taken]
                                                       > self.tolerance)))

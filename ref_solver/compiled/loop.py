@@ -44,9 +44,9 @@ class StepRecord:
     steps since the previous sample: ``solver_iterations`` (S,) summed, ``solver_residual``
     (S,) largest, ``solver_converged`` (S,) all. Steps (index k - 1 for step k):
     ``step_iterations``, ``step_residual``, ``step_converged``, ``step_projection_converged``,
-    ``step_sweeps`` (iterations x contacts, summed over the step's solves).
-    ``progress`` (2,): samples stored, steps completed; ``clock`` (1,): the time after the
-    last completed step [T].
+    ``step_sweeps`` (iterations x contacts, summed over the step's solves), ``step_split``
+    (computed in substeps: a localised impact). ``progress`` (2,): samples stored, steps
+    completed; ``clock`` (1,): the time after the last completed step [T].
     """
 
     times: np.ndarray
@@ -67,6 +67,7 @@ class StepRecord:
     step_sweeps: np.ndarray
     progress: np.ndarray
     clock: np.ndarray
+    step_split: np.ndarray
 
     @classmethod
     def allocate(cls, body_count: int, pair_count: int, steps: int, samples: int) -> StepRecord:
@@ -81,7 +82,7 @@ class StepRecord:
             step_residual=np.zeros(steps), step_converged=np.ones(steps, np.bool_),
             step_projection_converged=np.ones(steps, np.bool_),
             step_sweeps=np.zeros(steps, np.int64), progress=np.zeros(2, np.int64),
-            clock=np.zeros(1))
+            clock=np.zeros(1), step_split=np.zeros(steps, np.bool_))
 
     def arrays(self) -> tuple:
         """The arrays in the argument order of :func:`_advance`."""
@@ -90,7 +91,7 @@ class StepRecord:
                 self.active_contacts, self.solver_iterations, self.solver_residual,
                 self.solver_converged, self.step_iterations, self.step_residual,
                 self.step_converged, self.step_projection_converged, self.step_sweeps,
-                self.progress, self.clock)
+                self.progress, self.clock, self.step_split)
 
 
 @njit(cache=True)
@@ -137,7 +138,7 @@ def _advance(s, cfg, memory, t, x, p, v, omega, steps, schedule, history, rec):
     cand = candidates(s.geometry, x, rotation_matrices(p))
     for k in range(1, steps + 1):
         (x1, p1, v1, omega1, impulses, frames, active, its, res, ok, projection_ok,
-         sweeps, cand) = single_step(s, cfg, memory, t, x, p, v, omega, history, cand)
+         sweeps, cand, split) = single_step(s, cfg, memory, t, x, p, v, omega, history, cand)
         remember_angles(rotation_matrices(p1), s.force_kind, s.force_body_a, s.force_body_b,
                         s.force_parameters, memory[3])
         t = t + cfg.time_step
@@ -151,6 +152,7 @@ def _advance(s, cfg, memory, t, x, p, v, omega, steps, schedule, history, rec):
         rec[13][k - 1] = ok
         rec[14][k - 1] = projection_ok
         rec[15][k - 1] = sweeps
+        rec[18][k - 1] = split
         progress[1] = k
         if not (ok and projection_ok):
             status = UNCONVERGED

@@ -317,9 +317,9 @@ def single_step(s, cfg, memory, t, x, p, v, omega, history, cand):
     omega at t + h, impulses (npair, K, 3) in the contact frames [F T], frames (npair, K, 3, 3)
     of the contacts at the start of the step (of their last piece), active (npair, K), solver
     iterations, residual, converged, projection converged, contact sweeps, the candidates at
-    the returned (x, p)). The last activation round's closing test computes those candidates;
-    the next step starts from them instead of computing them again (the same kernel on the
-    same state: the same values to the bit).
+    the returned (x, p), whether the step was split). The last activation round's closing
+    test computes those candidates; the next step starts from them instead of computing them
+    again (the same kernel on the same state: the same values to the bit).
     """
     none = np.zeros(cand[0].shape, dtype=np.bool_)
     h = cfg.time_step
@@ -327,7 +327,7 @@ def single_step(s, cfg, memory, t, x, p, v, omega, history, cand):
     result = _substep(s, cfg, memory, t, h, x, p, v, omega, history, cand, none, splits > 0)
     if result[12] == np.inf:
         return (result[0], result[1], result[2], result[3], result[4], cand[3], result[5],
-                result[6], result[7], result[8], result[9], result[10], result[11])
+                result[6], result[7], result[8], result[9], result[10], result[11], False)
     world = np.zeros_like(result[4])
     frames = cand[3].copy()
     active = np.zeros_like(none)
@@ -384,4 +384,4 @@ def single_step(s, cfg, memory, t, x, p, v, omega, history, cand):
                                      + frames[i, k, a, 1] * world[i, k, 1]
                                      + frames[i, k, a, 2] * world[i, k, 2])
     return (x, p, v, omega, impulses, frames, active, iterations, residual, converged,
-            projection_converged, sweeps, cand)
+            projection_converged, sweeps, cand, True)
