@@ -335,25 +335,20 @@ def single_step(s, cfg, memory, t, x, p, v, omega, history, cand):
     iterations, residual, converged = result[6], 0.0, True
     projection_converged, sweeps = True, result[10]
     while True:
-        # (a) The free motion to the crossing, the crossing contacts not activated.
+        # (a) The free motion to the crossing, the crossing contacts not activated; (b) the
+        # impact at the crossing as a step of zero length, unless every crossing contact is
+        # still open there (the rest of the step then takes it).
         fraction = min(result[12] * (1.0 + 1e-9) + 4.0 * np.finfo(np.float64).eps, 1.0)
         h1 = fraction * h
         mask = result[13]
-        piece = _substep(s, cfg, memory, t, h1, x, p, v, omega, history, cand, mask, False)
-        _add_piece(world, frames, active, piece[4], cand[3], piece[5])
-        t = t + h1
-        x, p, v, omega, cand = piece[0], piece[1], piece[2], piece[3], piece[11]
-        iterations += piece[6]
-        residual = max(residual, piece[7])
-        converged = converged and piece[8]
-        projection_converged = projection_converged and piece[9]
-        sweeps += piece[10]
-        # (b) The impact at the crossing as a step of zero length, unless every crossing
-        # contact is still open there (the rest of the step then takes it).
-        if (valid_slots(cand[4], cand[0] <= cfg.activation_margin) & mask).any():
-            piece = _substep(s, cfg, memory, t, 0.0, x, p, v, omega, history, cand, none,
-                             False)
+        for piece_length, suppress in ((h1, mask), (0.0, none)):
+            if piece_length == 0.0 and not (
+                    valid_slots(cand[4], cand[0] <= cfg.activation_margin) & mask).any():
+                break
+            piece = _substep(s, cfg, memory, t, piece_length, x, p, v, omega, history, cand,
+                             suppress, False)
             _add_piece(world, frames, active, piece[4], cand[3], piece[5])
+            t = t + piece_length
             x, p, v, omega, cand = piece[0], piece[1], piece[2], piece[3], piece[11]
             iterations += piece[6]
             residual = max(residual, piece[7])
